@@ -1,0 +1,680 @@
+#include "experiments/scene/scene_reader.hpp"
+
+#include "experiments/scene/quantity.hpp"
+
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <initializer_list>
+#include <numbers>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace kerf {
+
+namespace fs = std::filesystem;
+
+std::vector<fs::path> geometry_search_path() {
+  std::vector<fs::path> dirs;
+#ifdef KERF_GEO_DIR
+  dirs.emplace_back(KERF_GEO_DIR);
+#endif
+  if (const char* env = std::getenv("KERF_GEO_PATH")) {
+    std::string_view rest(env);
+    while (!rest.empty()) {
+      const std::size_t colon = rest.find(':');
+      const std::string_view dir = rest.substr(0, colon);
+      if (!dir.empty()) dirs.emplace_back(std::string(dir));
+      if (colon == std::string_view::npos) break;
+      rest.remove_prefix(colon + 1);
+    }
+  }
+  return dirs;
+}
+
+namespace {
+
+/// A table of the scene file with its key path ("tools[1].trajectory") and where it starts.
+struct TableRef {
+  const toml::table& table;
+  std::string path;          ///< "" for the root table
+  toml::source_region where; ///< the table's header (or its parent's, when implicit)
+
+  [[nodiscard]] std::string key(std::string_view k) const {
+    return path.empty() ? std::string(k) : path + "." + std::string(k);
+  }
+  [[nodiscard]] const toml::node* find(std::string_view k) const { return table.get(k); }
+};
+
+std::string join(std::initializer_list<std::string_view> words) {
+  std::string out;
+  for (std::string_view w : words) {
+    if (!out.empty()) out += ", ";
+    out += w;
+  }
+  return out;
+}
+
+std::string type_name(const toml::node& n) {
+  switch (n.type()) {
+  case toml::node_type::table: return "a table";
+  case toml::node_type::array: return "an array";
+  case toml::node_type::string: return "a string";
+  case toml::node_type::integer: return "an integer";
+  case toml::node_type::floating_point: return "a floating-point number";
+  case toml::node_type::boolean: return "a boolean";
+  case toml::node_type::date: return "a date";
+  case toml::node_type::time: return "a time of day";
+  case toml::node_type::date_time: return "a date-time";
+  default: return "nothing";
+  }
+}
+
+/// What was written, for "got ..." in messages.
+std::string found(const toml::node& n) {
+  if (const auto* s = n.as_string()) return "\"" + s->get() + "\"";
+  if (const auto* i = n.as_integer()) return std::to_string(i->get());
+  if (const auto* f = n.as_floating_point()) {
+    std::ostringstream os;
+    os << f->get();
+    return os.str();
+  }
+  if (const auto* b = n.as_boolean()) return b->get() ? "true" : "false";
+  if (const auto* a = n.as_array()) {
+    std::string out = "[";
+    for (std::size_t k = 0; k < a->size(); ++k) {
+      if (k > 0) out += ", ";
+      out += found(*a->get(k));
+    }
+    return out + "]";
+  }
+  return type_name(n);
+}
+
+/// Whether `word` occurs in `text` as a whole identifier.
+bool mentions_identifier(std::string_view text, std::string_view word) {
+  const auto is_ident = [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+  };
+  for (std::size_t pos = text.find(word); pos != std::string_view::npos; pos = text.find(word, pos + 1)) {
+    const bool left = pos == 0 || !is_ident(text[pos - 1]);
+    const bool right = pos + word.size() == text.size() || !is_ident(text[pos + word.size()]);
+    if (left && right) return true;
+  }
+  return false;
+}
+
+constexpr double pi = std::numbers::pi;
+
+/// Reads one scene file; every error names file:line:column and the key path.
+class SceneParser {
+public:
+  explicit SceneParser(const fs::path& file)
+      : m_file(file), m_display(file.string()),
+        m_folder(fs::absolute(file).lexically_normal().parent_path()) {}
+
+  Scene read() {
+    std::ifstream in(m_file, std::ios::binary);
+    if (!in) throw SceneError(m_display + ": cannot open the scene file");
+    std::ostringstream text;
+    text << in.rdbuf();
+
+    toml::table root;
+    try {
+      root = toml::parse(text.str(), m_display);
+    } catch (const toml::parse_error& e) {
+      throw SceneError(position(e.source()) + ": TOML syntax: " + std::string(e.description()));
+    }
+
+    toml::source_region top;
+    top.begin = {1, 1};
+    top.end = {1, 1};
+    const TableRef doc{root, "", top};
+    allow_only(doc, {"scene", "geometry", "material", "layers", "supports", "tools", "models"});
+
+    Scene scene;
+    scene.file = m_file;
+    read_header(required_table(doc, "scene"), scene);
+    scene.geometry = read_geometry(required_table(doc, "geometry"));
+    scene.material = read_material(required_table(doc, "material"), nullptr, scene.phenomena);
+    read_layers(doc, scene);
+    read_supports(doc, scene);
+    read_tools(doc, scene);
+    if (const auto models = optional_table(doc, "models")) {
+      allow_only(*models, {"fracture", "voxel"});
+      if (const auto t = optional_table(*models, "fracture")) scene.fracture = read_fracture(*t);
+      if (const auto t = optional_table(*models, "voxel")) scene.voxel = read_voxel(*t);
+    }
+    check_consistency(doc, scene);
+    return scene;
+  }
+
+private:
+  fs::path m_file;
+  std::string m_display;
+  fs::path m_folder;
+  /// The [scene].phenomena entries, for consistency errors at the right place.
+  std::vector<std::pair<Phenomenon, const toml::node*>> m_phenomenon_nodes;
+  const toml::node* m_phenomena_node = nullptr;
+  std::vector<toml::source_region> m_tool_where;
+  std::vector<toml::source_region> m_layer_where;
+
+  // --- messages -------------------------------------------------------------------------------
+
+  [[nodiscard]] std::string position(const toml::source_region& at) const {
+    const unsigned line = at.begin.line == 0 ? 1u : at.begin.line;
+    const unsigned column = at.begin.column == 0 ? 1u : at.begin.column;
+    return m_display + ":" + std::to_string(line) + ":" + std::to_string(column);
+  }
+
+  [[noreturn]] void fail(const toml::source_region& at, std::string_view key, std::string_view message) const {
+    throw SceneError(position(at) + ": " + std::string(key) + ": " + std::string(message));
+  }
+
+  /// A node's own position, or the enclosing table's when toml++ has none for it.
+  static toml::source_region where(const toml::node& n, const TableRef& parent) {
+    return n.source().begin.line != 0 ? n.source() : parent.where;
+  }
+
+  [[noreturn]] void missing(const TableRef& t, std::string_view key, std::string_view expected) const {
+    fail(t.where, t.key(key), "missing required key (expected " + std::string(expected) + ")");
+  }
+
+  [[noreturn]] void wrong(const toml::node& n, const TableRef& t, const std::string& key,
+                          std::string_view expected) const {
+    fail(where(n, t), key, "expected " + std::string(expected) + ", got " + found(n));
+  }
+
+  // --- tables ---------------------------------------------------------------------------------
+
+  /// Every key of `t` must be one of `allowed`.
+  void allow_only(const TableRef& t, std::initializer_list<std::string_view> allowed,
+                  std::string_view what = "") const {
+    for (auto&& [k, v] : t.table) {
+      bool known = false;
+      for (std::string_view a : allowed) known = known || k.str() == a;
+      if (known) continue;
+      const toml::source_region at = k.source().begin.line != 0 ? k.source() : where(v, t);
+      std::string message = "unknown key";
+      if (!what.empty()) message += std::string(" for ") + std::string(what);
+      fail(at, t.key(k.str()), message + " (expected one of: " + join(allowed) + ")");
+    }
+  }
+
+  std::optional<TableRef> optional_table(const TableRef& t, std::string_view key) const {
+    const toml::node* n = t.find(key);
+    if (n == nullptr) return std::nullopt;
+    const toml::table* sub = n->as_table();
+    if (sub == nullptr) wrong(*n, t, t.key(key), "a table ([" + t.key(key) + "])");
+    return TableRef{*sub, t.key(key), where(*n, t)};
+  }
+
+  TableRef required_table(const TableRef& t, std::string_view key) const {
+    auto sub = optional_table(t, key);
+    if (!sub) missing(t, key, "a table [" + t.key(key) + "]");
+    return *sub;
+  }
+
+  /// An array of tables ([[key]]), possibly absent (empty result).
+  std::vector<TableRef> table_array(const TableRef& t, std::string_view key) const {
+    std::vector<TableRef> out;
+    const toml::node* n = t.find(key);
+    if (n == nullptr) return out;
+    const toml::array* a = n->as_array();
+    if (a == nullptr) wrong(*n, t, t.key(key), "an array of tables ([[" + t.key(key) + "]])");
+    for (std::size_t k = 0; k < a->size(); ++k) {
+      const toml::node& e = *a->get(k);
+      const std::string path = t.key(key) + "[" + std::to_string(k) + "]";
+      const toml::table* sub = e.as_table();
+      if (sub == nullptr) wrong(e, t, path, "a table ([[" + t.key(key) + "]])");
+      out.push_back(TableRef{*sub, path, where(e, t)});
+    }
+    return out;
+  }
+
+  // --- values ---------------------------------------------------------------------------------
+
+  std::optional<std::string> optional_string(const TableRef& t, std::string_view key) const {
+    const toml::node* n = t.find(key);
+    if (n == nullptr) return std::nullopt;
+    const auto* s = n->as_string();
+    if (s == nullptr) wrong(*n, t, t.key(key), "a string");
+    return s->get();
+  }
+
+  std::string required_string(const TableRef& t, std::string_view key) const {
+    auto s = optional_string(t, key);
+    if (!s) missing(t, key, "a string");
+    if (s->empty()) fail(where(*t.find(key), t), t.key(key), "expected a non-empty string, got \"\"");
+    return *s;
+  }
+
+  /// A quantity node: a string with a unit, or a plain (SI) number.
+  double quantity(const toml::node& n, const TableRef& t, const std::string& key, Dimension d) const {
+    if (const auto* s = n.as_string()) {
+      try {
+        return parse_quantity(s->get(), d);
+      } catch (const QuantityError& e) {
+        fail(where(n, t), key, e.what());
+      }
+    }
+    if (n.is_integer() || n.is_floating_point()) {
+      const double v = *n.value<double>();
+      if (!std::isfinite(v)) wrong(n, t, key, describe(d) + " (a finite number)");
+      return v;
+    }
+    wrong(n, t, key, describe(d));
+  }
+
+  std::optional<double> optional_quantity(const TableRef& t, std::string_view key, Dimension d) const {
+    const toml::node* n = t.find(key);
+    if (n == nullptr) return std::nullopt;
+    return quantity(*n, t, t.key(key), d);
+  }
+
+  double required_quantity(const TableRef& t, std::string_view key, Dimension d) const {
+    auto v = optional_quantity(t, key, d);
+    if (!v) missing(t, key, describe(d));
+    return *v;
+  }
+
+  /// Fails at `key` of `t` with "expected <range>, got <written>" unless `ok`.
+  void check(bool ok, const TableRef& t, std::string_view key, std::string_view range) const {
+    if (ok) return;
+    wrong(*t.find(key), t, t.key(key), range);
+  }
+
+  int required_integer(const TableRef& t, std::string_view key) const {
+    const toml::node* n = t.find(key);
+    if (n == nullptr) missing(t, key, "an integer");
+    const auto* i = n->as_integer();
+    if (i == nullptr) wrong(*n, t, t.key(key), "an integer");
+    return static_cast<int>(std::clamp<std::int64_t>(i->get(), -1000000, 1000000));
+  }
+
+  /// A 3-vector: an array of three quantities.
+  Eigen::Vector3d vector3(const TableRef& t, std::string_view key, Dimension d, bool nonzero) const {
+    const toml::node* n = t.find(key);
+    if (n == nullptr) missing(t, key, "an array of three " + describe(d));
+    const toml::array* a = n->as_array();
+    const std::string path = t.key(key);
+    if (a == nullptr || a->size() != 3) wrong(*n, t, path, "an array of three " + describe(d));
+    Eigen::Vector3d v;
+    for (std::size_t k = 0; k < 3; ++k)
+      v[static_cast<Eigen::Index>(k)] = quantity(*a->get(k), t, path + "[" + std::to_string(k) + "]", d);
+    if (nonzero && !(v.norm() > 0.0)) wrong(*n, t, path, "a non-zero vector");
+    return v;
+  }
+
+  // --- files ----------------------------------------------------------------------------------
+
+  /// Resolves `name` against the scene's folder, then `search`; fails at `key` if not found.
+  fs::path resolve_file(const TableRef& t, std::string_view key, const std::string& name,
+                        const std::vector<fs::path>& search) const {
+    const fs::path p(name);
+    std::vector<fs::path> candidates;
+    if (p.is_absolute()) {
+      candidates.push_back(p);
+    } else {
+      candidates.push_back(m_folder / p);
+      for (const fs::path& dir : search) candidates.push_back(dir / p);
+    }
+    std::error_code ec;
+    for (const fs::path& c : candidates)
+      if (fs::is_regular_file(c, ec)) return fs::absolute(c).lexically_normal();
+    std::string looked;
+    for (const fs::path& c : candidates) {
+      if (!looked.empty()) looked += ", ";
+      looked += c.lexically_normal().string();
+    }
+    fail(where(*t.find(key), t), t.key(key), "file \"" + name + "\" not found (looked for: " + looked + ")");
+  }
+
+  // --- sections -------------------------------------------------------------------------------
+
+  void read_header(const TableRef& t, Scene& scene) {
+    allow_only(t, {"name", "description", "phenomena"});
+    scene.name = required_string(t, "name");
+    scene.description = optional_string(t, "description").value_or("");
+    const toml::node* n = t.find("phenomena");
+    const std::string expected = "a non-empty array of phenomena (deformation, cutting, tearing, friction, layers)";
+    if (n == nullptr) missing(t, "phenomena", expected);
+    const toml::array* a = n->as_array();
+    if (a == nullptr || a->empty()) wrong(*n, t, t.key("phenomena"), expected);
+    m_phenomena_node = n;
+    for (std::size_t k = 0; k < a->size(); ++k) {
+      const toml::node& e = *a->get(k);
+      const std::string path = t.key("phenomena") + "[" + std::to_string(k) + "]";
+      const auto* s = e.as_string();
+      const std::optional<Phenomenon> p = s ? phenomenon_from_string(s->get()) : std::nullopt;
+      if (!p) wrong(e, t, path, "one of deformation, cutting, tearing, friction, layers");
+      if (scene.phenomena.contains(*p)) fail(where(e, t), path, "\"" + s->get() + "\" is listed twice");
+      scene.phenomena.insert(*p);
+      m_phenomenon_nodes.emplace_back(*p, &e);
+    }
+  }
+
+  SceneGeometry read_geometry(const TableRef& t) const {
+    allow_only(t, {"geo", "stl", "msh", "stl_scale", "element_size", "parameters"});
+    SceneGeometry g;
+    std::string_view source_key;
+    for (std::string_view k : {"geo", "stl", "msh"}) {
+      if (t.find(k) == nullptr) continue;
+      if (!source_key.empty())
+        fail(where(*t.find(k), t), t.key(k),
+             "give exactly one of geo, stl, msh (found " + std::string(source_key) + " and " + std::string(k) + ")");
+      source_key = k;
+    }
+    if (source_key.empty()) missing(t, "geo", "one of geo = \"NAME.geo\", stl = \"NAME.stl\", msh = \"NAME.msh\"");
+    g.kind = source_key == "geo" ? SceneGeometry::Kind::geo
+             : source_key == "stl" ? SceneGeometry::Kind::stl
+                                   : SceneGeometry::Kind::msh;
+    const std::string name = required_string(t, source_key);
+    const std::string extension = "." + std::string(source_key);
+    if (fs::path(name).extension() != extension)
+      wrong(*t.find(source_key), t, t.key(source_key), "a file name ending in " + extension);
+    g.source = resolve_file(t, source_key, name, geometry_search_path());
+
+    if (t.find("stl_scale") != nullptr) {
+      if (g.kind != SceneGeometry::Kind::stl)
+        fail(where(*t.find("stl_scale"), t), t.key("stl_scale"), "only applies to stl geometry");
+      g.stl_scale = required_quantity(t, "stl_scale", Dimension::dimensionless);
+      check(g.stl_scale > 0.0, t, "stl_scale", "a scale > 0");
+    }
+
+    if (g.kind == SceneGeometry::Kind::msh) {
+      g.element_size = optional_quantity(t, "element_size", Dimension::length).value_or(0.0);
+      if (t.find("element_size") != nullptr) check(g.element_size > 0.0, t, "element_size", "a length > 0");
+    } else {
+      g.element_size = required_quantity(t, "element_size", Dimension::length);
+      check(g.element_size > 0.0, t, "element_size", "a length > 0");
+    }
+
+    if (const toml::node* n = t.find("parameters")) {
+      if (g.kind != SceneGeometry::Kind::geo)
+        fail(where(*n, t), t.key("parameters"), "only applies to geo geometry");
+      const auto p = optional_table(t, "parameters");
+      std::string geo_text;
+      {
+        std::ifstream in(g.source, std::ios::binary);
+        std::ostringstream s;
+        s << in.rdbuf();
+        geo_text = s.str();
+      }
+      for (auto&& [k, v] : p->table) {
+        const std::string key = p->key(k.str());
+        // Catch misspelt parameters: a .geo parameter is named in its file.
+        if (!mentions_identifier(geo_text, k.str()))
+          fail(k.source().begin.line != 0 ? k.source() : where(v, *p), key,
+               "unknown parameter (" + g.source.filename().string() + " does not define \"" +
+                   std::string(k.str()) + "\")");
+        // Strings carry a length unit; plain numbers are SI or unitless (cut_normal).
+        g.parameters[std::string(k.str())] = quantity(v, *p, key, Dimension::length);
+      }
+    }
+    return g;
+  }
+
+  /// The base material (`base == nullptr`, region "body") or a layer: a copy of `base` with the
+  /// keys the layer gives.
+  Material read_material(const TableRef& t, const Material* base, PhenomenonSet phenomena) const {
+    const bool layer = base != nullptr;
+    if (layer)
+      allow_only(t, {"region", "law", "youngs_modulus", "poisson_ratio", "density", "fracture_toughness",
+                     "cohesive_strength", "friction_coefficient", "damping"});
+    else
+      allow_only(t, {"law", "youngs_modulus", "poisson_ratio", "density", "fracture_toughness",
+                     "cohesive_strength", "friction_coefficient", "damping"});
+    Material m = layer ? *base : Material{};
+    m.region = layer ? required_string(t, "region") : "body";
+
+    if (const auto law = layer ? optional_string(t, "law") : std::optional(required_string(t, "law"))) {
+      if (*law == "neo-hookean")
+        m.law = MaterialLaw::neo_hookean;
+      else if (*law == "st-venant-kirchhoff")
+        m.law = MaterialLaw::st_venant_kirchhoff;
+      else
+        wrong(*t.find("law"), t, t.key("law"), "\"neo-hookean\" or \"st-venant-kirchhoff\"");
+    }
+
+    // Required in the base material; cutting/tearing need J_c and σ_c, friction needs μ.
+    const bool fracture = phenomena.contains(Phenomenon::cutting) || phenomena.contains(Phenomenon::tearing);
+    const bool friction = phenomena.contains(Phenomenon::friction);
+    const auto get = [&](std::string_view key, Dimension d, bool required, double& into) -> bool {
+      const auto v = (required && !layer) ? std::optional(required_quantity(t, key, d)) : optional_quantity(t, key, d);
+      if (v) into = *v;
+      return v.has_value();
+    };
+    if (get("youngs_modulus", Dimension::pressure, true, m.youngs_modulus))
+      check(m.youngs_modulus > 0.0, t, "youngs_modulus", "a modulus > 0");
+    if (get("poisson_ratio", Dimension::dimensionless, true, m.poisson_ratio))
+      check(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5, t, "poisson_ratio", "a ratio in (-1, 0.5)");
+    if (get("density", Dimension::density, true, m.density))
+      check(m.density > 0.0, t, "density", "a density > 0");
+    if (get("fracture_toughness", Dimension::energy_per_area, fracture, m.fracture_toughness))
+      check(m.fracture_toughness > 0.0, t, "fracture_toughness", "a toughness > 0");
+    if (get("cohesive_strength", Dimension::pressure, fracture, m.cohesive_strength))
+      check(m.cohesive_strength > 0.0, t, "cohesive_strength", "a strength > 0");
+    if (get("friction_coefficient", Dimension::dimensionless, friction, m.friction_coefficient))
+      check(m.friction_coefficient >= 0.0, t, "friction_coefficient", "a coefficient >= 0");
+    if (get("damping", Dimension::viscosity, false, m.damping))
+      check(m.damping >= 0.0, t, "damping", "a viscosity >= 0");
+    return m;
+  }
+
+  void read_layers(const TableRef& doc, Scene& scene) {
+    std::set<std::string> regions;
+    for (const TableRef& t : table_array(doc, "layers")) {
+      Material m = read_material(t, &scene.material, scene.phenomena);
+      if (!regions.insert(m.region).second || m.region == "body")
+        fail(where(*t.find("region"), t), t.key("region"),
+             "region \"" + m.region + "\" is already used (each layer needs its own physical volume)");
+      scene.layers.push_back(std::move(m));
+      m_layer_where.push_back(t.where);
+    }
+  }
+
+  void read_supports(const TableRef& doc, Scene& scene) const {
+    const auto tables = table_array(doc, "supports");
+    if (tables.empty()) missing(doc, "supports", "at least one [[supports]] table with surface and kind");
+    for (const TableRef& t : tables) {
+      allow_only(t, {"surface", "kind"});
+      Support s;
+      s.surface = required_string(t, "surface");
+      const std::string kind = required_string(t, "kind");
+      if (kind == "bonded")
+        s.kind = Support::Kind::bonded;
+      else if (kind == "sliding")
+        s.kind = Support::Kind::sliding;
+      else
+        wrong(*t.find("kind"), t, t.key("kind"), "\"bonded\" or \"sliding\"");
+      scene.supports.push_back(std::move(s));
+    }
+  }
+
+  void read_tools(const TableRef& doc, Scene& scene) {
+    const auto tables = table_array(doc, "tools");
+    if (tables.empty()) missing(doc, "tools", "one or two [[tools]] tables");
+    if (tables.size() > 2)
+      fail(tables[2].where, tables[2].path,
+           "a scene has one or two tools (found " + std::to_string(tables.size()) + ")");
+    for (const TableRef& t : tables) {
+      Tool tool;
+      tool.name = required_string(t, "name");
+      for (const Tool& other : scene.tools)
+        if (other.name == tool.name)
+          fail(where(*t.find("name"), t), t.key("name"), "tool name \"" + tool.name + "\" is used twice");
+      const std::string kind = required_string(t, "kind");
+      if (kind == "blade") {
+        tool.kind = Tool::Kind::blade;
+        allow_only(t, {"name", "kind", "edge_direction", "cutting_direction", "edge_length", "wedge_angle",
+                       "thickness", "trajectory"},
+                   "a blade tool");
+        BladeShape& b = tool.blade;
+        b.edge_direction = vector3(t, "edge_direction", Dimension::dimensionless, true).normalized();
+        b.cutting_direction = vector3(t, "cutting_direction", Dimension::dimensionless, true).normalized();
+        if (!(std::abs(b.edge_direction.dot(b.cutting_direction)) < 1e-6)) {
+          std::ostringstream cosine;
+          cosine << b.edge_direction.dot(b.cutting_direction);
+          fail(where(*t.find("cutting_direction"), t), t.key("cutting_direction"),
+               "expected a direction orthogonal to edge_direction, got " + found(*t.find("cutting_direction")) +
+                   " (cosine " + cosine.str() + " with edge_direction " + found(*t.find("edge_direction")) + ")");
+        }
+        b.edge_length = required_quantity(t, "edge_length", Dimension::length);
+        check(b.edge_length > 0.0, t, "edge_length", "a length > 0");
+        b.wedge_angle = required_quantity(t, "wedge_angle", Dimension::angle);
+        check(b.wedge_angle > 0.0 && b.wedge_angle < pi, t, "wedge_angle", "an angle in (0, 180 deg)");
+        b.thickness = required_quantity(t, "thickness", Dimension::length);
+        check(b.thickness > 0.0, t, "thickness", "a length > 0");
+      } else if (kind == "sphere") {
+        tool.kind = Tool::Kind::sphere;
+        allow_only(t, {"name", "kind", "radius", "trajectory"}, "a sphere tool");
+        tool.radius = required_quantity(t, "radius", Dimension::length);
+        check(tool.radius > 0.0, t, "radius", "a length > 0");
+      } else {
+        wrong(*t.find("kind"), t, t.key("kind"), "\"blade\" or \"sphere\"");
+      }
+      tool.trajectory = read_trajectory(required_table(t, "trajectory"));
+      scene.tools.push_back(std::move(tool));
+      m_tool_where.push_back(t.where);
+    }
+  }
+
+  TrajectorySpec read_trajectory(const TableRef& t) const {
+    allow_only(t, {"rate", "start", "segments", "file"});
+    TrajectorySpec spec;
+    spec.rate = required_quantity(t, "rate", Dimension::frequency);
+    check(spec.rate > 0.0, t, "rate", "a frequency > 0");
+    if (t.find("file") != nullptr) {
+      for (std::string_view k : {"start", "segments"})
+        if (t.find(k) != nullptr)
+          fail(where(*t.find(k), t), t.key(k), "a recorded trajectory (file) takes no start or segments");
+      spec.recorded_file = resolve_file(t, "file", required_string(t, "file"), {});
+      return spec;
+    }
+    spec.start = vector3(t, "start", Dimension::length, false);
+    const auto segments = table_array(t, "segments");
+    if (segments.empty()) missing(t, "segments", "at least one [[" + t.key("segments") + "]] (or file = \"NAME.csv\")");
+    for (const TableRef& s : segments) {
+      TrajectorySegment seg;
+      const std::string kind = required_string(s, "kind");
+      if (kind == "move") {
+        allow_only(s, {"kind", "label", "to", "speed"}, "a move segment");
+        seg.kind = TrajectorySegment::Kind::move;
+        seg.target = vector3(s, "to", Dimension::length, false);
+        seg.speed = required_quantity(s, "speed", Dimension::velocity);
+        check(seg.speed > 0.0, s, "speed", "a speed > 0");
+      } else if (kind == "dwell") {
+        allow_only(s, {"kind", "label", "duration"}, "a dwell segment");
+        seg.kind = TrajectorySegment::Kind::dwell;
+        seg.duration = required_quantity(s, "duration", Dimension::time);
+        check(seg.duration > 0.0, s, "duration", "a duration > 0");
+      } else {
+        wrong(*s.find("kind"), s, s.key("kind"), "\"move\" or \"dwell\"");
+      }
+      seg.label = optional_string(s, "label").value_or("");
+      spec.segments.push_back(std::move(seg));
+    }
+    return spec;
+  }
+
+  FractureResponseParameters read_fracture(const TableRef& t) const {
+    allow_only(t, {"rupture_force_per_length", "rupture_deflection", "deformation_1_exponent", "crack_deflection",
+                   "deformation_2_exponent", "lateral_stiffness", "presliding_stiffness", "presliding_stick_ratio"});
+    FractureResponseParameters f;
+    f.rupture_force_per_length = required_quantity(t, "rupture_force_per_length", Dimension::force_per_length);
+    check(f.rupture_force_per_length > 0.0, t, "rupture_force_per_length", "a force per length > 0");
+    f.rupture_deflection = required_quantity(t, "rupture_deflection", Dimension::length);
+    check(f.rupture_deflection > 0.0, t, "rupture_deflection", "a length > 0");
+    f.deformation_1_exponent = required_integer(t, "deformation_1_exponent");
+    check(f.deformation_1_exponent >= 1 && f.deformation_1_exponent <= 3, t, "deformation_1_exponent",
+          "an exponent 1, 2 or 3 (paper 001 §6)");
+    f.crack_deflection = required_quantity(t, "crack_deflection", Dimension::length);
+    check(f.crack_deflection > 0.0, t, "crack_deflection", "a length > 0");
+    f.deformation_2_exponent = required_integer(t, "deformation_2_exponent");
+    check(f.deformation_2_exponent >= 1 && f.deformation_2_exponent <= 3, t, "deformation_2_exponent",
+          "an exponent 1, 2 or 3 (paper 001 §6)");
+    f.lateral_stiffness = required_quantity(t, "lateral_stiffness", Dimension::force_per_length);
+    check(f.lateral_stiffness >= 0.0, t, "lateral_stiffness", "a stiffness >= 0");
+    f.presliding_stiffness = required_quantity(t, "presliding_stiffness", Dimension::force_per_length);
+    check(f.presliding_stiffness > 0.0, t, "presliding_stiffness", "a stiffness > 0");
+    if (const auto r = optional_quantity(t, "presliding_stick_ratio", Dimension::dimensionless)) {
+      f.presliding_stick_ratio = *r;
+      check(*r >= 0.0 && *r < 1.0, t, "presliding_stick_ratio", "a ratio in [0, 1)");
+    }
+    return f;
+  }
+
+  VoxelModelSettings read_voxel(const TableRef& t) const {
+    allow_only(t, {"elastic_coefficient", "friction_coefficient", "damping_coefficient", "critical_force_cutting",
+                   "critical_force_depth", "advance_length", "grid"});
+    VoxelModelSettings v;
+    v.elastic_coefficient = required_quantity(t, "elastic_coefficient", Dimension::pressure);
+    check(v.elastic_coefficient > 0.0, t, "elastic_coefficient", "a coefficient > 0");
+    v.friction_coefficient = required_quantity(t, "friction_coefficient", Dimension::dimensionless);
+    check(v.friction_coefficient >= 0.0, t, "friction_coefficient", "a coefficient >= 0");
+    v.damping_coefficient = required_quantity(t, "damping_coefficient", Dimension::viscosity);
+    check(v.damping_coefficient >= 0.0, t, "damping_coefficient", "a coefficient >= 0");
+    v.critical_force_cutting = required_quantity(t, "critical_force_cutting", Dimension::force);
+    check(v.critical_force_cutting > 0.0, t, "critical_force_cutting", "a force > 0");
+    v.critical_force_depth = required_quantity(t, "critical_force_depth", Dimension::force);
+    check(v.critical_force_depth > 0.0, t, "critical_force_depth", "a force > 0");
+    v.advance_length = required_quantity(t, "advance_length", Dimension::length);
+    check(v.advance_length > 0.0, t, "advance_length", "a length > 0");
+    if (const toml::node* n = t.find("grid")) {
+      const toml::array* a = n->as_array();
+      const std::string expected = "an array of three cell counts >= 1, e.g. [10, 20, 20]";
+      if (a == nullptr || a->size() != 3) wrong(*n, t, t.key("grid"), expected);
+      for (std::size_t k = 0; k < 3; ++k) {
+        const auto* i = a->get(k)->as_integer();
+        if (i == nullptr || i->get() < 1 || i->get() > 100000) wrong(*n, t, t.key("grid"), expected);
+        v.grid[k] = static_cast<int>(i->get());
+      }
+    }
+    return v;
+  }
+
+  // --- the scene as a whole ---------------------------------------------------------------------
+
+  const toml::node* phenomenon_node(Phenomenon p) const {
+    for (const auto& [q, n] : m_phenomenon_nodes)
+      if (q == p) return n;
+    return m_phenomena_node;
+  }
+
+  void check_consistency(const TableRef& doc, const Scene& scene) const {
+    const std::string phenomena_key = "scene.phenomena";
+    const bool has_layers = scene.phenomena.contains(Phenomenon::layers);
+    if (!scene.layers.empty() && !has_layers)
+      fail(m_layer_where.front(), "layers",
+           "the scene has [[layers]] but scene.phenomena does not declare \"layers\"");
+    if (has_layers && scene.layers.empty())
+      fail(phenomenon_node(Phenomenon::layers)->source(), phenomena_key,
+           "\"layers\" is declared but the scene has no [[layers]] table");
+    if (scene.phenomena.contains(Phenomenon::cutting)) {
+      bool blade = false;
+      for (const Tool& tool : scene.tools) blade = blade || tool.kind == Tool::Kind::blade;
+      // Paper 002 cuts with the tip of a cutting stick (a sphere tool) in its voxel model.
+      if (!blade && !scene.voxel)
+        fail(phenomenon_node(Phenomenon::cutting)->source(), phenomena_key,
+             "\"cutting\" needs a blade tool (found only sphere tools; a sphere cuts only with [models.voxel])");
+    }
+    if (scene.phenomena.contains(Phenomenon::tearing) && scene.tools.size() < 2)
+      fail(phenomenon_node(Phenomenon::tearing)->source(), phenomena_key,
+           "\"tearing\" needs two tools pulling the body apart (found " + std::to_string(scene.tools.size()) + ")");
+    (void)doc;
+  }
+};
+
+} // namespace
+
+Scene read_scene(const fs::path& file) { return SceneParser(file).read(); }
+
+} // namespace kerf
