@@ -1,0 +1,54 @@
+#pragma once
+// The models kerf can run, what each covers, and how each is built from a scene.
+
+#include "experiments/scene/scene.hpp"
+#include "meshes/tet_mesh.hpp"
+#include "realtime/tool_model.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <memory>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+namespace kerf {
+
+/// One entry of `kerf models`.
+struct ModelDescription {
+  std::string_view name;     ///< command-line name
+  std::string_view summary;  ///< one line
+  std::string_view source;   ///< paper and section
+  PhenomenonSet covers;      ///< phenomena it can represent
+  std::string_view tools;    ///< which tools it takes
+};
+
+/// Every model that exists in this build (a model that is not built is not listed).
+std::span<const ModelDescription> model_catalogue();
+const ModelDescription* find_model(std::string_view name);
+
+/// A model that cannot represent a scene: the message says what is missing.
+class ModelMismatch : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// A model built for a scene, with the parameters it was built with (for the manifest).
+struct BuiltModel {
+  std::unique_ptr<ToolModel> model;
+  nlohmann::json parameters;
+};
+
+/// Checks, before any meshing, that model `name` exists and can represent `scene`: it covers
+/// every phenomenon the scene declares and the scene has the tools and parameter sections the
+/// model needs. Throws std::invalid_argument (unknown name) or ModelMismatch (saying what is
+/// missing); returns the model's description.
+const ModelDescription& require_model_for_scene(std::string_view name, const Scene& scene);
+
+/// Builds model `name` for `scene` on its mesh (after require_model_for_scene). Throws ModelMismatch when the model cannot
+/// represent a phenomenon the scene declares, or lacks a tool or parameter section it needs —
+/// naming what is missing — and std::invalid_argument for an unknown model name.
+BuiltModel make_model(std::string_view name, const Scene& scene, const TetMesh& mesh);
+
+} // namespace kerf

@@ -1,0 +1,101 @@
+#pragma once
+// Scene: everything a run needs to know about one experiment (../shared/DESIGN.md, "Scene"),
+// read from experiments/scenes/NAME.toml. All quantities are SI: the reader converts units once.
+
+#include "experiments/trajectory/trajectory.hpp"
+#include "realtime/fracture/fracture_response.hpp"
+#include "realtime/phenomena.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kerf {
+
+/// Where the body's geometry comes from: a parametric .geo (meshes/geo), a closed STL surface
+/// that gmsh meshes into tetrahedra, or a ready tetrahedral .msh (checked for inverted elements
+/// when it is loaded).
+struct SceneGeometry {
+  enum class Kind { geo, stl, msh };
+  Kind kind = Kind::geo;
+  std::filesystem::path source;               ///< absolute path of the .geo, .stl or .msh
+  std::map<std::string, double> parameters;   ///< .geo parameters, SI
+  double element_size = 0.0;                  ///< target tetrahedron size [m] > 0
+  double stl_scale = 1.0;                     ///< STL coordinates times this = metres
+};
+
+enum class MaterialLaw { neo_hookean, st_venant_kirchhoff };
+
+/// Material of the body or of one layer. Literature names; SI units.
+struct Material {
+  std::string region;                 ///< physical volume it applies to ("body" for the base material)
+  MaterialLaw law = MaterialLaw::neo_hookean;
+  double youngs_modulus = 0.0;        ///< E [Pa] > 0
+  double poisson_ratio = 0.0;         ///< ν in (-1, 0.5)
+  double density = 0.0;               ///< ρ [kg/m^3] > 0
+  double fracture_toughness = 0.0;    ///< J_c [J/m^2] > 0
+  double cohesive_strength = 0.0;     ///< σ_c [Pa] > 0
+  double friction_coefficient = 0.0;  ///< μ >= 0 (tool on body)
+  double damping = 0.0;               ///< Kelvin–Voigt viscosity η [Pa s] >= 0
+};
+
+/// A supported face: `bonded` fixes all displacement (paper 001's samples were glued to a
+/// plate); `sliding` fixes the normal displacement only (a block resting on a table).
+struct Support {
+  enum class Kind { bonded, sliding };
+  std::string surface; ///< physical surface name
+  Kind kind = Kind::bonded;
+};
+
+/// A blade: a straight edge of length `edge_length` through the tool's reference point along
+/// `edge_direction`, advancing along `cutting_direction`; a wedge of angle `wedge_angle` and back
+/// thickness `thickness` behind it.
+struct BladeShape {
+  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();    ///< unit
+  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ(); ///< unit, orthogonal to the edge
+  double edge_length = 0.0;  ///< [m] > 0
+  double wedge_angle = 0.0;  ///< [rad] in (0, pi)
+  double thickness = 0.0;    ///< [m] > 0
+};
+
+/// A tool: a blade, or a sphere/stylus tip of radius `radius`, and its trajectory.
+struct Tool {
+  enum class Kind { blade, sphere };
+  std::string name;
+  Kind kind = Kind::blade;
+  BladeShape blade;           ///< blade only
+  double radius = 0.0;        ///< [m] > 0, sphere only
+  TrajectorySpec trajectory;
+};
+
+/// Paper 002 Table 1 parameters of the local voxel/polygon cutting model, as written there.
+struct VoxelModelSettings {
+  double elastic_coefficient = 0.0;     ///< [N/m^2] (Table 1 unit)
+  double friction_coefficient = 0.0;
+  double damping_coefficient = 0.0;     ///< [N s/m^2]
+  double critical_force_cutting = 0.0;  ///< [N]
+  double critical_force_depth = 0.0;    ///< [N]
+  double advance_length = 0.0;          ///< [m]
+  std::array<int, 3> grid{10, 20, 20};  ///< local voxel grid cells (paper 002 §4: 10x20x20)
+};
+
+struct Scene {
+  std::filesystem::path file;        ///< the scene file as given
+  std::string name;
+  std::string description;
+  PhenomenonSet phenomena;
+  SceneGeometry geometry;
+  Material material;                 ///< base material (region "body")
+  std::vector<Material> layers;      ///< per-region overrides, complete materials
+  std::vector<Support> supports;
+  std::vector<Tool> tools;           ///< one or two
+  std::optional<FractureResponseParameters> fracture;  ///< [models.fracture]
+  std::optional<VoxelModelSettings> voxel;             ///< [models.voxel]
+};
+
+} // namespace kerf

@@ -1,0 +1,28 @@
+#pragma once
+// Reading scene files (toml++). Units are converted here, once.
+
+#include "experiments/scene/scene.hpp"
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+
+namespace kerf {
+
+/// A scene file that cannot be used. what() reads
+/// "FILE:LINE:COLUMN: KEY: what was expected (what was found)".
+class SceneError : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Reads and validates a scene file. Unknown keys, missing fields, wrong units, non-finite or
+/// out-of-range values, a missing geometry or trajectory file, and inconsistent tools are
+/// SceneErrors naming file:line:column and the key.
+Scene read_scene(const std::filesystem::path& file);
+
+/// Directories searched for a scene's `geo = "NAME.geo"` after the scene file's own folder:
+/// the kerf source tree's meshes/geo (compiled in) and $KERF_GEO_PATH if set.
+std::vector<std::filesystem::path> geometry_search_path();
+
+} // namespace kerf

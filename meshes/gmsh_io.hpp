@@ -1,0 +1,33 @@
+#pragma once
+// gmsh through its C++ API: mesh a parametric .geo or a closed STL surface into tetrahedra, read
+// and write .msh 4.1. One reader for both sides of kerf (the reference builds its deal.II
+// triangulation from the TetMesh this returns, see ../shared/notes/dealii-on-debian12.md).
+
+#include "meshes/tet_mesh.hpp"
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+namespace kerf {
+
+/// Meshes the .geo file `geo` with its parameters overridden by `parameters` (name -> value in
+/// SI units; each name must be a parameter the .geo declares with `DefineConstant`, otherwise
+/// MeshError) and the target element size `element_size` [m]. Returns first-order tetrahedra with
+/// all physical groups of the .geo. Throws MeshError naming the file on any gmsh error.
+TetMesh mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
+                 double element_size);
+
+/// Meshes the volume enclosed by a closed STL surface (a scan, say; coordinates in metres after
+/// multiplying by `scale`) with element size `element_size` [m]. The result has the physical
+/// volume `body` and the physical surface `boundary`.
+TetMesh mesh_stl(const std::filesystem::path& stl, double element_size, double scale = 1.0);
+
+/// Reads a .msh file (any version gmsh reads) holding first-order tetrahedra and triangles.
+TetMesh read_msh(const std::filesystem::path& msh);
+
+/// Writes .msh 4.1 ASCII with nodes, tetrahedra and physical groups, atomically
+/// (temporary file, then rename).
+void write_msh(const TetMesh& mesh, const std::filesystem::path& msh);
+
+} // namespace kerf

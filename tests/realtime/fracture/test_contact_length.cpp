@@ -1,0 +1,86 @@
+// SegmentLengthInBody against the closed-form length of a segment inside a box (Liang–Barsky
+// clipping of the segment to the box: an independent method, no tetrahedra involved).
+
+#include "meshes/box_tet_mesh.hpp"
+#include "realtime/fracture/contact_length.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace kerf;
+
+namespace {
+
+const Eigen::Vector3d lower(0.0, -0.010, 0.0);
+const Eigen::Vector3d upper(0.040, 0.010, 0.015);
+
+/// Length of [a, b] inside the box [lower, upper] by slab clipping (closed form).
+double box_clip_length(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  double t0 = 0.0, t1 = 1.0;
+  const Eigen::Vector3d d = b - a;
+  for (int i = 0; i < 3; ++i) {
+    if (d[i] == 0.0) {
+      if (a[i] < lower[i] || a[i] > upper[i]) return 0.0;
+      continue;
+    }
+    double s0 = (lower[i] - a[i]) / d[i], s1 = (upper[i] - a[i]) / d[i];
+    if (s0 > s1) std::swap(s0, s1);
+    t0 = std::max(t0, s0);
+    t1 = std::min(t1, s1);
+  }
+  return t1 > t0 ? (t1 - t0) * d.norm() : 0.0;
+}
+
+} // namespace
+
+TEST(ContactLength, BladeEdgeAcrossTheWidthInAMeshPlane) {
+  // The edge lies in the grid plane x = 20 mm, i.e. in faces shared by two tetrahedra: the
+  // union of intervals must count it once. Expected: the box width, 20 mm.
+  SegmentLengthInBody length(box_tet_mesh(lower, upper, 8, 4, 3));
+  for (double z : {0.0, 0.001, 0.005, 0.0075, 0.0149, 0.015}) {
+    EXPECT_NEAR(length.length({0.020, -0.015, z}, {0.020, 0.015, z}), 0.020, 1e-10) << "z = " << z;
+  }
+  EXPECT_NEAR(length.length({0.020, -0.015, 0.0151}, {0.020, 0.015, 0.0151}), 0.0, 1e-12); // above the top
+}
+
+TEST(ContactLength, AlongMeshEdgesAndOnTheBoundary) {
+  SegmentLengthInBody length(box_tet_mesh(lower, upper, 8, 4, 3));
+  // Along a grid line (edges of many tetrahedra) and along a boundary edge of the box.
+  EXPECT_NEAR(length.length({-0.01, 0.0, 0.005}, {0.05, 0.0, 0.005}), 0.040, 1e-10);
+  EXPECT_NEAR(length.length({-0.01, 0.010, 0.015}, {0.05, 0.010, 0.015}), 0.040, 1e-10);
+}
+
+TEST(ContactLength, RandomSegmentsMatchTheClosedForm) {
+  SegmentLengthInBody length(box_tet_mesh(lower, upper, 5, 3, 4));
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.02, 0.06);
+  for (int trial = 0; trial < 500; ++trial) {
+    const Eigen::Vector3d a(u(rng), u(rng) - 0.02, u(rng) - 0.02), b(u(rng), u(rng) - 0.02, u(rng) - 0.02);
+    EXPECT_NEAR(length.length(a, b), box_clip_length(a, b), 1e-10) << "trial " << trial;
+  }
+}
+
+TEST(ContactLength, PerRegionLengthsOfALayeredBox) {
+  // Two regions split at z = 9 mm (a grid plane for nz = 5): a vertical segment through the
+  // whole depth has 9 mm in the lower region and 6 mm in the upper one.
+  TetMesh mesh = box_tet_mesh(lower, upper, 4, 2, 5);
+  VolumeGroup up{"layer_upper", 10, {}}, down{"layer_lower", 11, {}};
+  for (int t = 0; t < mesh.tets.rows(); ++t) {
+    double z = 0.0;
+    for (int v = 0; v < 4; ++v) z += mesh.nodes(mesh.tets(t, v), 2) / 4.0;
+    (z > 0.009 ? up : down).tets.push_back(t);
+  }
+  mesh.volume_groups.push_back(up);
+  mesh.volume_groups.push_back(down);
+  SegmentLengthInBody length(mesh, {"layer_upper", "layer_lower"});
+  double l[2];
+  const double total = length.lengths({0.013, 0.001, -0.01}, {0.013, 0.001, 0.03}, l);
+  EXPECT_NEAR(l[0], 0.006, 1e-10);
+  EXPECT_NEAR(l[1], 0.009, 1e-10);
+  EXPECT_NEAR(total, 0.015, 1e-10);
+}
+
+TEST(ContactLength, MissingRegionIsAnError) {
+  EXPECT_ANY_THROW(SegmentLengthInBody(box_tet_mesh(lower, upper, 1, 1, 1), {"no_such_group"}));
+}

@@ -1,0 +1,111 @@
+// The realtime contract (../shared/DESIGN.md): `step` allocates nothing. This program replaces
+// the global operator new/delete and (outside sanitizer builds) glibc's malloc family with
+// counting versions, then steps the fracture model through a full approach–cut–dwell–retreat–
+// re-entry cycle with friction and two layers, and requires zero allocations during the steps.
+
+#include "meshes/box_tet_mesh.hpp"
+#include "realtime/fracture/fracture_cutting_model.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+namespace {
+std::atomic<long> allocations{0};
+thread_local bool counting = false;
+void note_allocation() {
+  if (counting) allocations.fetch_add(1, std::memory_order_relaxed);
+}
+} // namespace
+
+void* operator new(std::size_t size) {
+  note_allocation();
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void* operator new(std::size_t size, std::align_val_t align) {
+  note_allocation();
+  if (void* p = std::aligned_alloc(static_cast<std::size_t>(align), (size + static_cast<std::size_t>(align) - 1) / static_cast<std::size_t>(align) * static_cast<std::size_t>(align))) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size, std::align_val_t align) { return operator new(size, align); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+#if !defined(__SANITIZE_ADDRESS__) && defined(__GLIBC__)
+// Eigen and C code allocate with malloc directly: count those too, through glibc's own entry
+// points (sanitizer builds intercept malloc themselves, so there only operator new is counted).
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* malloc(std::size_t size) {
+  note_allocation();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  note_allocation();
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) {
+  note_allocation();
+  return __libc_realloc(p, size);
+}
+}
+#endif
+
+using namespace kerf;
+
+TEST(RealtimeContract, FractureModelStepAllocatesNothing) {
+  TetMesh mesh = box_tet_mesh({0.0, -0.010, 0.0}, {0.040, 0.010, 0.015}, 8, 4, 5);
+  VolumeGroup up{"layer_upper", 10, {}}, down{"layer_lower", 11, {}};
+  for (int t = 0; t < mesh.tets.rows(); ++t) {
+    double z = 0.0;
+    for (int v = 0; v < 4; ++v) z += mesh.nodes(mesh.tets(t, v), 2) / 4.0;
+    (z > 0.009 ? up : down).tets.push_back(t);
+  }
+  mesh.volume_groups.push_back(up);
+  mesh.volume_groups.push_back(down);
+
+  FractureCuttingSetup s;
+  s.edge_length = 0.030;
+  s.regions = {"layer_upper", "layer_lower"};
+  s.fracture_toughness = {600.0, 200.0};
+  s.response = {400.0, 0.002, 2, 0.0005, 1, 2000.0, 5000.0, 0.5};
+  s.friction = true;
+  s.friction_coefficient = 0.4;
+  s.crack_capture_width = 1e-3;
+  FractureCuttingModel model(mesh, s);
+
+  // Sanity check that the counter works at all.
+  counting = true;
+  delete new int(3);
+  counting = false;
+  ASSERT_EQ(allocations.load(), 1);
+  allocations = 0;
+
+  ToolState tool;
+  ForceSample out;
+  long modes_seen = 0;
+  counting = true;
+  for (int pass = 0; pass < 2; ++pass) {     // the second pass re-enters the crack
+    for (int k = 0; k <= 30000; ++k) {        // approach, cut 14 mm, retreat, with a lateral wobble
+      const double z = k <= 15000 ? 0.016 - 1e-6 * k : 0.001 + 1e-6 * (k - 15000);
+      tool.position = {0.020, 5e-5 * std::sin(1e-3 * k), z};
+      model.step({&tool, 1}, 1e-3, {&out, 1});
+      modes_seen |= 1L << static_cast<int>(out.mode);
+    }
+  }
+  counting = false;
+  EXPECT_EQ(allocations.load(), 0);
+  EXPECT_EQ(modes_seen, 0b11111); // every mode was exercised while counting
+}
