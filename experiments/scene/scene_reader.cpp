@@ -152,7 +152,7 @@ public:
       if (const auto t = optional_table(*models, "fracture")) scene.fracture = read_fracture(*t);
       if (const auto t = optional_table(*models, "voxel")) scene.voxel = read_voxel(*t);
     }
-    check_consistency(doc, scene);
+    check_consistency(scene);
     return scene;
   }
 
@@ -161,7 +161,12 @@ private:
   std::string m_display;
   fs::path m_folder;
   /// The [scene].phenomena entries, for consistency errors at the right place.
-  std::vector<std::pair<Phenomenon, const toml::node*>> m_phenomenon_nodes;
+  struct PhenomenonEntry {
+    Phenomenon phenomenon;
+    const toml::node* node;
+    std::string key; ///< "scene.phenomena[k]"
+  };
+  std::vector<PhenomenonEntry> m_phenomenon_nodes;
   const toml::node* m_phenomena_node = nullptr;
   std::vector<toml::source_region> m_tool_where;
   std::vector<toml::source_region> m_layer_where;
@@ -267,7 +272,7 @@ private:
     }
     if (n.is_integer() || n.is_floating_point()) {
       const double v = *n.value<double>();
-      if (!std::isfinite(v)) wrong(n, t, key, describe(d) + " (a finite number)");
+      if (!std::isfinite(v)) fail(where(n, t), key, "expected " + describe(d) + ", got " + found(n) + " (not a finite number)");
       return v;
     }
     wrong(n, t, key, describe(d));
@@ -357,7 +362,7 @@ private:
       if (!p) wrong(e, t, path, "one of deformation, cutting, tearing, friction, layers");
       if (scene.phenomena.contains(*p)) fail(where(e, t), path, "\"" + s->get() + "\" is listed twice");
       scene.phenomena.insert(*p);
-      m_phenomenon_nodes.emplace_back(*p, &e);
+      m_phenomenon_nodes.push_back({*p, &e, path});
     }
   }
 
@@ -643,33 +648,29 @@ private:
 
   // --- the scene as a whole ---------------------------------------------------------------------
 
-  const toml::node* phenomenon_node(Phenomenon p) const {
-    for (const auto& [q, n] : m_phenomenon_nodes)
-      if (q == p) return n;
-    return m_phenomena_node;
+  /// Fails at the entry of scene.phenomena that declares `p`.
+  [[noreturn]] void fail_at_phenomenon(Phenomenon p, std::string_view message) const {
+    for (const PhenomenonEntry& e : m_phenomenon_nodes)
+      if (e.phenomenon == p) fail(e.node->source(), e.key, message);
+    fail(m_phenomena_node->source(), "scene.phenomena", message);
   }
 
-  void check_consistency(const TableRef& doc, const Scene& scene) const {
-    const std::string phenomena_key = "scene.phenomena";
+  void check_consistency(const Scene& scene) const {
     const bool has_layers = scene.phenomena.contains(Phenomenon::layers);
     if (!scene.layers.empty() && !has_layers)
-      fail(m_layer_where.front(), "layers",
+      fail(m_layer_where.front(), "layers[0]",
            "the scene has [[layers]] but scene.phenomena does not declare \"layers\"");
     if (has_layers && scene.layers.empty())
-      fail(phenomenon_node(Phenomenon::layers)->source(), phenomena_key,
-           "\"layers\" is declared but the scene has no [[layers]] table");
+      fail_at_phenomenon(Phenomenon::layers, "\"layers\" is declared but the scene has no [[layers]] table");
     if (scene.phenomena.contains(Phenomenon::cutting)) {
       bool blade = false;
       for (const Tool& tool : scene.tools) blade = blade || tool.kind == Tool::Kind::blade;
       // Paper 002 cuts with the tip of a cutting stick (a sphere tool) in its voxel model.
       if (!blade && !scene.voxel)
-        fail(phenomenon_node(Phenomenon::cutting)->source(), phenomena_key,
-             "\"cutting\" needs a blade tool (found only sphere tools; a sphere cuts only with [models.voxel])");
+        fail_at_phenomenon(Phenomenon::cutting, "\"cutting\" needs a blade tool (found only sphere tools; a sphere cuts only with [models.voxel])");
     }
     if (scene.phenomena.contains(Phenomenon::tearing) && scene.tools.size() < 2)
-      fail(phenomenon_node(Phenomenon::tearing)->source(), phenomena_key,
-           "\"tearing\" needs two tools pulling the body apart (found " + std::to_string(scene.tools.size()) + ")");
-    (void)doc;
+      fail_at_phenomenon(Phenomenon::tearing, "\"tearing\" needs two tools pulling the body apart (found " + std::to_string(scene.tools.size()) + ")");
   }
 };
 
