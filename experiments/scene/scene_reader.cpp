@@ -170,6 +170,20 @@ private:
   const toml::node* m_phenomena_node = nullptr;
   std::vector<toml::source_region> m_tool_where;
   std::vector<toml::source_region> m_layer_where;
+  /// The text of a .geo geometry ("" for stl/msh): parameters and physical names are checked in it.
+  std::string m_geo_text;
+  std::string m_geo_name;
+
+  /// A .geo must define the physical group `name` (a support surface or a layer volume); stl and
+  /// msh files are not checked here.
+  void check_physical_name(const TableRef& t, std::string_view key, const std::string& name,
+                           std::string_view what) const {
+    if (m_geo_text.empty()) return;
+    if (m_geo_text.find("\"" + name + "\"") != std::string::npos) return;
+    fail(where(*t.find(key), t), t.key(key),
+         "expected " + std::string(what) + " defined in " + m_geo_name + ", got \"" + name +
+             "\" (no such physical group)");
+  }
 
   // --- messages -------------------------------------------------------------------------------
 
@@ -366,7 +380,7 @@ private:
     }
   }
 
-  SceneGeometry read_geometry(const TableRef& t) const {
+  SceneGeometry read_geometry(const TableRef& t) {
     allow_only(t, {"geo", "stl", "msh", "stl_scale", "element_size", "parameters"});
     SceneGeometry g;
     std::string_view source_key;
@@ -386,6 +400,13 @@ private:
     if (fs::path(name).extension() != extension)
       wrong(*t.find(source_key), t, t.key(source_key), "a file name ending in " + extension);
     g.source = resolve_file(t, source_key, name, geometry_search_path());
+    if (g.kind == SceneGeometry::Kind::geo) {
+      std::ifstream in(g.source, std::ios::binary);
+      std::ostringstream s;
+      s << in.rdbuf();
+      m_geo_text = s.str();
+      m_geo_name = g.source.filename().string();
+    }
 
     if (t.find("stl_scale") != nullptr) {
       if (g.kind != SceneGeometry::Kind::stl)
@@ -406,17 +427,10 @@ private:
       if (g.kind != SceneGeometry::Kind::geo)
         fail(where(*n, t), t.key("parameters"), "only applies to geo geometry");
       const auto p = optional_table(t, "parameters");
-      std::string geo_text;
-      {
-        std::ifstream in(g.source, std::ios::binary);
-        std::ostringstream s;
-        s << in.rdbuf();
-        geo_text = s.str();
-      }
       for (auto&& [k, v] : p->table) {
         const std::string key = p->key(k.str());
         // Catch misspelt parameters: a .geo parameter is named in its file.
-        if (!mentions_identifier(geo_text, k.str()))
+        if (!mentions_identifier(m_geo_text, k.str()))
           fail(k.source().begin.line != 0 ? k.source() : where(v, *p), key,
                "unknown parameter (" + g.source.filename().string() + " does not define \"" +
                    std::string(k.str()) + "\")");
@@ -478,6 +492,7 @@ private:
     std::set<std::string> regions;
     for (const TableRef& t : table_array(doc, "layers")) {
       Material m = read_material(t, &scene.material, scene.phenomena);
+      check_physical_name(t, "region", m.region, "a physical volume");
       if (!regions.insert(m.region).second || m.region == "body")
         fail(where(*t.find("region"), t), t.key("region"),
              "region \"" + m.region + "\" is already used (each layer needs its own physical volume)");
@@ -493,6 +508,7 @@ private:
       allow_only(t, {"surface", "kind"});
       Support s;
       s.surface = required_string(t, "surface");
+      check_physical_name(t, "surface", s.surface, "a physical surface");
       const std::string kind = required_string(t, "kind");
       if (kind == "bonded")
         s.kind = Support::Kind::bonded;

@@ -371,7 +371,7 @@ TEST_F(SceneReaderTest, SINumbersAndUnitsMixAndDirectionsAreNormalised) {
 }
 
 TEST_F(SceneReaderTest, GeometryIsFoundBesideTheSceneFirst) {
-  write("rect_prism.geo", "// local copy\nlength = 1;\n");
+  write("rect_prism.geo", "// local copy\nlength = 1;\nPhysical Surface(\"support\") = {1};\n");
   const Scene s = read_scene(write("s.toml", minimal()));
   EXPECT_EQ(s.geometry.source, m_dir / "rect_prism.geo");
 }
