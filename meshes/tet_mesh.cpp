@@ -3,6 +3,8 @@
 #include "meshes/mesh_error.hpp"
 #include "meshes/tet_quality.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <string>

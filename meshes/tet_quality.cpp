@@ -1,5 +1,7 @@
 #include "meshes/tet_quality.hpp"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
