@@ -2,6 +2,7 @@
 // TetMesh: the one tetrahedral mesh type shared by the fast models and the reference.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <string>
 #include <string_view>

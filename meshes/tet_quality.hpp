@@ -6,6 +6,7 @@
 #include "meshes/tet_mesh.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace kerf {
 

@@ -30,7 +30,9 @@ Box(3) = {0, -width / 2, z_interface, cut_offset, width, upper_thickness};
 Box(4) = {cut_offset, -width / 2, z_interface, length - cut_offset, width, upper_thickness};
 parts() = BooleanFragments{ Volume{1}; Delete; }{ Volume{2, 3, 4}; Delete; };
 
-eps = 1e-6 * (length + width + depth);
+// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (1e-7), so
+// eps must exceed that, and stay far below any distance between distinct faces.
+eps = 1e-4 * (length + width + depth);
 lower() = Volume In BoundingBox{-eps, -width / 2 - eps, -eps, length + eps, width / 2 + eps, z_interface + eps};
 upper() = Volume In BoundingBox{-eps, -width / 2 - eps, z_interface - eps, length + eps, width / 2 + eps, depth + eps};
 support() = Surface In BoundingBox{-eps, -width / 2 - eps, -eps, length + eps, width / 2 + eps, eps};
@@ -41,6 +43,10 @@ sides() = CombinedBoundary{ Volume{parts()}; };
 sides() = Abs(sides());
 sides() -= support();
 sides() -= top();
+
+If (#support() == 0 || #top() == 0 || #cut() == 0 || #sides() == 0 || #interface() == 0 || #lower() == 0 || #upper() == 0)
+  Error("layered_block.geo: a physical group selection came out empty (bounding-box tolerance eps = %g)", eps);
+EndIf
 
 Physical Volume("body") = {parts()};
 Physical Volume("layer_lower") = {lower()};

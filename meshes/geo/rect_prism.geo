@@ -31,7 +31,9 @@ EndIf
 // Fragmenting the two halves makes them share the cut face, so the mesh is conforming across it.
 parts() = BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; };
 
-eps = 1e-6 * (length + width + depth);
+// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (1e-7), so
+// eps must exceed that, and stay far below any distance between distinct faces.
+eps = 1e-4 * (length + width + depth);
 support() = Surface In BoundingBox{-eps, -width / 2 - eps, -eps, length + eps, width / 2 + eps, eps};
 top() = Surface In BoundingBox{-eps, -width / 2 - eps, depth - eps, length + eps, width / 2 + eps, depth + eps};
 If (cut_normal == 0)
@@ -43,6 +45,10 @@ sides() = CombinedBoundary{ Volume{parts()}; };
 sides() = Abs(sides());
 sides() -= support();
 sides() -= top();
+
+If (#support() == 0 || #top() == 0 || #cut() == 0 || #sides() == 0)
+  Error("rect_prism.geo: a physical group selection came out empty (bounding-box tolerance eps = %g)", eps);
+EndIf
 
 Physical Volume("body") = {parts()};
 Physical Surface("support") = {support()};

@@ -35,7 +35,9 @@ EndFor
 // Fragmenting the two halves makes them share the cut face, so the mesh is conforming across it.
 parts() = BooleanFragments{ Volume{half[0]}; Delete; }{ Volume{half[1]}; Delete; };
 
-eps = 1e-6 * (length + base_width + depth);
+// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (1e-7), so
+// eps must exceed that, and stay far below any distance between distinct faces.
+eps = 1e-4 * (length + base_width + depth);
 support() = Surface In BoundingBox{-eps, -base_width / 2 - eps, -eps, length + eps, base_width / 2 + eps, eps};
 cut() = Surface In BoundingBox{cut_offset - eps, -base_width / 2 - eps, -eps, cut_offset + eps, base_width / 2 + eps, depth + eps};
 sides() = Surface In BoundingBox{-eps, -base_width / 2 - eps, -eps, eps, base_width / 2 + eps, depth + eps};
@@ -44,6 +46,10 @@ top() = CombinedBoundary{ Volume{parts()}; };
 top() = Abs(top());
 top() -= support();
 top() -= sides();
+
+If (#support() == 0 || #top() == 0 || #cut() == 0 || #sides() == 0)
+  Error("tri_prism.geo: a physical group selection came out empty (bounding-box tolerance eps = %g)", eps);
+EndIf
 
 Physical Volume("body") = {parts()};
 Physical Surface("support") = {support()};
