@@ -1,3 +1,6 @@
+// Units of scene quantities to SI (quantity.hpp). One table of spellings; J/m^2 and N/m share a
+// dimension. A bare number is SI.
+
 #include "experiments/scene/quantity.hpp"
 
 #include <array>

@@ -1,3 +1,6 @@
+// Scene files (TOML, toml++) to Scene (scene_reader.hpp). Every key is known, every quantity is
+// converted once, and every error reads "FILE:LINE:COLUMN: KEY: what was expected, got what".
+
 #include "experiments/scene/scene_reader.hpp"
 
 #include "experiments/scene/quantity.hpp"
