@@ -293,13 +293,24 @@ TetMesh mesh_geo(const fs::path& geo, const std::map<std::string, double>& param
   require_file(geo, ".geo");
   GmshSession session(geo.string());
   const std::string file = fs::absolute(geo).string();
-  session.run("reading", [&] { gmsh::open(file); });
-  if (!parameters.empty()) {
-    // Pass 1 above told which parameters the file declares; pass 2 reopens it with the
-    // overrides in the ONELAB database, which DefineConstant reads in preference to its
-    // default (a parameter defaulted from another, e.g. cut_offset = length / 2, follows it).
+  if (parameters.empty()) {
+    session.run("reading", [&] { gmsh::open(file); });
+  } else {
+    // Pass 1 opens the file with its defaults to learn which parameters it declares (the
+    // DefineConstant blocks come first, so the names are known even if the defaults alone make
+    // the geometry fail: such errors are left to pass 2). Pass 2 reopens it with the overrides
+    // in the ONELAB database, which DefineConstant reads in preference to its default (a
+    // parameter defaulted from another, e.g. cut_offset = length / 2, follows it). Verified
+    // against gmsh 4.8.4 by test_geo_library.
+    std::string defaults_error;
+    try {
+      session.run("reading", [&] { gmsh::open(file); });
+    } catch (const MeshError& e) {
+      defaults_error = e.what(); // reported by pass 2 if it persists with the overrides
+    }
     const std::set<std::string> declared = declared_parameters();
     for (const auto& [name, value] : parameters) {
+      if (declared.count(name) == 0 && !defaults_error.empty()) throw MeshError(defaults_error);
       if (declared.count(name) == 0)
         throw MeshError(geo.string() + ": unknown parameter '" + name + "'; the file declares: " + join(declared));
       if (!std::isfinite(value))

@@ -222,6 +222,25 @@ TEST(GeoLibraryParameters, GeoErrorIsAMeshErrorAndGmshRecovers) {
     out << "SetFactory(\"OpenCASCADE\");\nBox(1) = {0, 0, 0, 1, 1;\n";
   }
   EXPECT_THROW((void)mesh_geo(broken, {}, 0.5), MeshError);
+  try {
+    (void)mesh_geo(broken, {{"length", 1.0}}, 0.5); // the syntax error wins over "unknown parameter"
+    FAIL() << "expected MeshError";
+  } catch (const MeshError& e) {
+    EXPECT_NE(std::string(e.what()).find("syntax error"), std::string::npos) << e.what();
+  }
+  // Defaults that fail on their own but are fixed by the override: the override wins.
+  const auto fixable = std::filesystem::temp_directory_path() / "kerf_test_fixable.geo";
+  {
+    std::ofstream out(fixable);
+    out << "SetFactory(\"OpenCASCADE\");\n"
+           "DefineConstant[ size = {-1, Name \"Parameters/size\"} ];\n"
+           "If (size <= 0)\n  Error(\"size must be positive\");\nEndIf\n"
+           "Box(1) = {0, 0, 0, size, size, size};\nPhysical Volume(\"body\") = {1};\n";
+  }
+  EXPECT_THROW((void)mesh_geo(fixable, {}, 0.5), MeshError);
+  const TetMesh cube = mesh_geo(fixable, {{"size", 0.01}}, 0.004);
+  EXPECT_NEAR(mesh_volume(cube), 1e-6, 1e-15); // analytic: size^3
+  std::filesystem::remove(fixable);
   std::filesystem::remove(broken);
   // gmsh is still usable after the errors.
   const TetMesh mesh = mesh_geo(k_geo_dir / "rect_prism.geo", {}, 0.006);
