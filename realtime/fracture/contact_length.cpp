@@ -38,7 +38,7 @@ SegmentLengthInBody::SegmentLengthInBody(const TetMesh& mesh, const std::vector<
       boxes[t].extend(x[v]);
       for (int w = v + 1; w < 4; ++w) size = std::max(size, (x[v] - x[w]).norm());
     }
-    m_tolerance[t] = 1e-9 * size;
+    m_tolerance[t] = 1e-12 * size;
     for (int k = 0; k < 4; ++k) {
       const Eigen::Vector3d& a = x[face_vertices[k][0]];
       Eigen::Vector3d n = (x[face_vertices[k][1]] - a).cross(x[face_vertices[k][2]] - a);

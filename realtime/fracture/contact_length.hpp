@@ -17,7 +17,7 @@ namespace kerf {
 /// Length of a segment inside a tetrahedral body, per region.
 ///
 /// The segment a + t (b - a), t in [0, 1], is clipped against each candidate tetrahedron
-/// (Cyrus–Beck clipping against its four face planes, closed with a tolerance of 1e-9 of the
+/// (Cyrus–Beck clipping against its four face planes, closed with a tolerance of 1e-12 of the
 /// tetrahedron's size so that a segment lying in a shared face — a blade edge travelling in the
 /// conforming `cut_plane` — is counted), and the parameter intervals of each region are merged
 /// (their union), so shared faces are never counted twice:

@@ -18,8 +18,9 @@ void require(bool condition, const std::string& what) {
   if (!condition) throw std::invalid_argument("fracture model: " + what);
 }
 
-/// Contact lengths below this are "no contact" [m] (a nanometre: far below any mesh size).
-constexpr double contact_threshold = 1e-9;
+/// Contact lengths below this are "no contact" [m] (a picometre: far below any mesh size, far
+/// above the clipping tolerance of SegmentLengthInBody).
+constexpr double contact_threshold = 1e-12;
 
 } // namespace
 
@@ -88,8 +89,9 @@ double FractureCuttingModel::entry_depth(const Eigen::Vector3d& p, double hint) 
     s_hi *= 2.0;
     ++doublings;
   }
-  // Bisection to a nanometre or 60 halvings, whichever first.
-  for (int k = 0; k < 60 && s_hi - s_lo > 1e-9; ++k) {
+  // Bisection to a picometre or 80 halvings, whichever first: the frame origin then sits on
+  // the surface to far below any deflection that matters.
+  for (int k = 0; k < 80 && s_hi - s_lo > 1e-12; ++k) {
     const double mid = 0.5 * (s_lo + s_hi);
     if (measure(p - mid * e_x) > contact_threshold) s_lo = mid;
     else s_hi = mid;

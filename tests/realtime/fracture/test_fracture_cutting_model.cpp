@@ -198,7 +198,8 @@ TEST(FractureCuttingModel, AFreshCutElsewhereStartsInState1) {
 }
 
 TEST(FractureCuttingModel, LateralWallAndSlidingFriction) {
-  // Cutting with the blade held 0.1 mm off its plane: wall force -k y = -0.2 N along y, and
+  // Cutting with the blade held 0.1 mm off its plane (along x, the normal of the blade's yz
+  // plane): wall force -k y = 0.2 N back towards the plane, and
   // once sliding, pre-sliding friction saturates at mu |f_y| opposing the advance.
   FractureCuttingSetup setup = razor();
   setup.friction = true;
@@ -206,10 +207,10 @@ TEST(FractureCuttingModel, LateralWallAndSlidingFriction) {
   setup.crack_capture_width = 1e-3;
   FractureCuttingModel model(potato_box(), setup);
   drive(model, path({above, {0.020, 0.0, 0.012}}));
-  const auto samples = drive(model, path({{0.020, 0.0, 0.012}, {0.020, 1e-4, 0.012}, {0.020, 1e-4, 0.008}}));
+  const auto samples = drive(model, path({{0.020, 0.0, 0.012}, {0.0201, 0.0, 0.012}, {0.0201, 0.0, 0.008}}));
   const Sample& last = samples.back();
   EXPECT_EQ(last.out.mode, InteractionMode::cutting);
-  EXPECT_NEAR(last.out.force.y(), -2000.0 * 1e-4, 1e-12);
+  EXPECT_NEAR(last.out.force.x(), -2000.0 * 1e-4, 1e-12);
   EXPECT_NEAR(last.out.force.z(), 4.0 + 0.5 * 0.2, 1e-9); // J_c l + mu N, both resisting the advance
 }
 

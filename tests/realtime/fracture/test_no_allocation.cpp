@@ -86,11 +86,11 @@ TEST(RealtimeContract, FractureModelStepAllocatesNothing) {
   s.crack_capture_width = 1e-3;
   FractureCuttingModel model(mesh, s);
 
-  // Sanity check that the counter works at all.
+  // Sanity check that the counter works at all (direct calls: a new-expression may be elided).
   counting = true;
-  delete new int(3);
+  ::operator delete(::operator new(16));
   counting = false;
-  ASSERT_EQ(allocations.load(), 1);
+  ASSERT_GE(allocations.load(), 1); // operator new, and the malloc under it where counted
   allocations = 0;
 
   ToolState tool;

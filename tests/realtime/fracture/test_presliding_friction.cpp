@@ -19,14 +19,37 @@ TEST(PreslidingFriction, StickIsElastic) {
 }
 
 TEST(PreslidingFriction, SteadySlidingIsCoulomb) {
-  // Far beyond breakaway the force saturates at mu N (Coulomb), opposing the motion.
+  // Past breakaway (alpha = 1) dz/dx = 1 - z/z_max, so z approaches z_max like
+  // exp(-x / z_max): after 40 z_max of sliding the force is mu N (Coulomb) to e^-40.
   PreslidingFriction f(1000.0, 0.5);
-  const double mu = 0.3, normal = 5.0;
+  const double mu = 0.3, normal = 5.0; // z_max = 1.5 mm
   double force = 0.0;
-  for (int i = 0; i < 10000; ++i) force = f.update(1e-6, normal, mu);
+  for (int i = 0; i < 60000; ++i) force = f.update(1e-6, normal, mu);
   EXPECT_NEAR(force, -mu * normal, 1e-9);
-  for (int i = 0; i < 20000; ++i) force = f.update(-1e-6, normal, mu);
+  for (int i = 0; i < 120000; ++i) force = f.update(-1e-6, normal, mu);
   EXPECT_NEAR(force, mu * normal, 1e-9);
+}
+
+TEST(PreslidingFriction, SlidingApproachesCoulombExponentially) {
+  // In the sliding regime the closed form of dz/dx = 1 - z/z_max is
+  // z(x) = z_max - (z_max - z0) exp(-(x - x0)/z_max); the discrete update follows it to
+  // O(dx / z_max).
+  PreslidingFriction f(1000.0, 0.0); // no stick zone
+  const double mu = 0.5, normal = 2.0, z_max = 1e-3, dx = 1e-8;
+  // Load to z_max first, reverse by half (elastic), then slide forward and compare.
+  for (int i = 0; i < 1000000; ++i) f.update(dx, normal, mu);
+  const double loaded = f.presliding_displacement();
+  for (int i = 0; i < 50000; ++i) f.update(-dx, normal, mu); // elastic unloading by 0.5 z_max
+  const double z0 = f.presliding_displacement();
+  EXPECT_NEAR(z0, loaded - 0.5 * z_max, 1e-12);
+  double x = 0.0;
+  for (int i = 0; i < 200000; ++i, x += dx) f.update(dx, normal, mu);
+  // With stick ratio 0, alpha follows Hayward & Armstrong's sine ramp from 0 to 1 over
+  // (0, z_max); alpha <= 1 makes dz/dx = 1 - alpha z/z_max >= 1 - z/z_max, so by comparison z
+  // stays between the alpha = 1 exponential and z_max:
+  const double exponential = z_max - (z_max - z0) * std::exp(-x / z_max);
+  EXPECT_GE(f.presliding_displacement(), exponential - 1e-9);
+  EXPECT_LE(f.presliding_displacement(), z_max);
 }
 
 TEST(PreslidingFriction, ReversalUnloadsElastically) {
