@@ -30,9 +30,10 @@ Box(3) = {0, -width / 2, z_interface, cut_offset, width, upper_thickness};
 Box(4) = {cut_offset, -width / 2, z_interface, length - cut_offset, width, upper_thickness};
 parts() = BooleanFragments{ Volume{1}; Delete; }{ Volume{2, 3, 4}; Delete; };
 
-// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (1e-7), so
-// eps must exceed that, and stay far below any distance between distinct faces.
-eps = 1e-4 * (length + width + depth);
+// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (~1e-7 m),
+// so eps must exceed that (1 um for a 1 mm body), and stay far below the distance between
+// distinct faces.
+eps = 1e-3 * Min(length, Min(width, depth));
 lower() = Volume In BoundingBox{-eps, -width / 2 - eps, -eps, length + eps, width / 2 + eps, z_interface + eps};
 upper() = Volume In BoundingBox{-eps, -width / 2 - eps, z_interface - eps, length + eps, width / 2 + eps, depth + eps};
 support() = Surface In BoundingBox{-eps, -width / 2 - eps, -eps, length + eps, width / 2 + eps, eps};

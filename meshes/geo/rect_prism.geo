@@ -31,9 +31,10 @@ EndIf
 // Fragmenting the two halves makes them share the cut face, so the mesh is conforming across it.
 parts() = BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; };
 
-// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (1e-7), so
-// eps must exceed that, and stay far below any distance between distinct faces.
-eps = 1e-4 * (length + width + depth);
+// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (~1e-7 m),
+// so eps must exceed that (1 um for a 1 mm body), and stay far below the distance between
+// distinct faces.
+eps = 1e-3 * Min(length, Min(width, depth));
 support() = Surface In BoundingBox{-eps, -width / 2 - eps, -eps, length + eps, width / 2 + eps, eps};
 top() = Surface In BoundingBox{-eps, -width / 2 - eps, depth - eps, length + eps, width / 2 + eps, depth + eps};
 If (cut_normal == 0)

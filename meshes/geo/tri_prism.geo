@@ -35,9 +35,10 @@ EndFor
 // Fragmenting the two halves makes them share the cut face, so the mesh is conforming across it.
 parts() = BooleanFragments{ Volume{half[0]}; Delete; }{ Volume{half[1]}; Delete; };
 
-// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (1e-7), so
-// eps must exceed that, and stay far below any distance between distinct faces.
-eps = 1e-4 * (length + base_width + depth);
+// Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (~1e-7 m),
+// so eps must exceed that (1 um for a 1 mm body), and stay far below the distance between
+// distinct faces.
+eps = 1e-3 * Min(length, Min(base_width, depth));
 support() = Surface In BoundingBox{-eps, -base_width / 2 - eps, -eps, length + eps, base_width / 2 + eps, eps};
 cut() = Surface In BoundingBox{cut_offset - eps, -base_width / 2 - eps, -eps, cut_offset + eps, base_width / 2 + eps, depth + eps};
 sides() = Surface In BoundingBox{-eps, -base_width / 2 - eps, -eps, eps, base_width / 2 + eps, depth + eps};

@@ -182,6 +182,19 @@ TEST(GeoLibraryParameters, LengthOverrideChangesVolumeAndMovesTheDefaultCut) {
   EXPECT_NEAR(group_volume(layered, "layer_upper"), 0.040 * 0.01 * 0.004, 1e-9 * 0.040 * 0.01 * 0.004);
 }
 
+TEST(GeoLibraryParameters, MillimetreCubeWithCutAlongTheLongAxis) {
+  // The sponge scenes (paper 002): a 1 mm cube, cut plane y = 0. Analytic: V = 1e-9 m^3, cut
+  // area L D = 1e-6 m^2. Checks that the selection tolerance still works at this scale.
+  const TetMesh mesh = mesh_geo(k_geo_dir / "rect_prism.geo",
+                                {{"length", 0.001}, {"width", 0.001}, {"depth", 0.001}, {"cut_normal", 1}, {"cut_offset", 0}},
+                                0.0002);
+  EXPECT_NEAR(mesh_volume(mesh), 1e-9, 1e-9 * 1e-9);
+  EXPECT_NEAR(surface_group_area(mesh, "cut_plane"), 1e-6, 1e-9 * 1e-6);
+  EXPECT_NEAR(surface_group_area(mesh, "support"), 1e-6, 1e-9 * 1e-6);
+  EXPECT_TRUE(tet_quality_summary(mesh).valid());
+  expect_conforming_internal_plane(mesh, "cut_plane", 1, 0.0, 0.001);
+}
+
 TEST(GeoLibraryParameters, UnknownParameterIsAnErrorNamingFileAndParameter) {
   try {
     (void)mesh_geo(k_geo_dir / "rect_prism.geo", {{"lenght", 0.05}}, 0.005);
