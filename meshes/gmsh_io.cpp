@@ -114,8 +114,6 @@ public:
     if (!errors.empty()) throw MeshError(m_file + ": " + what + " failed: " + errors);
   }
 
-  [[nodiscard]] const std::string& file() const { return m_file; }
-
 private:
   std::lock_guard<std::mutex> m_lock;
   std::string m_file;

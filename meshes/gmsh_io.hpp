@@ -12,8 +12,9 @@
 namespace kerf {
 
 /// Meshes the .geo file `geo` with its parameters overridden by `parameters` (name -> value in
-/// SI units; each name must be a parameter the .geo declares with `DefineConstant`, otherwise
-/// MeshError) and the target element size `element_size` [m]. Returns first-order tetrahedra with
+/// SI units; each name must be a parameter the .geo declares with `DefineConstant`, as
+/// `NAME = {default, Name "Parameters/NAME"}` like every file in meshes/geo, otherwise
+/// MeshError listing the declared names) and the target element size `element_size` [m]. Returns first-order tetrahedra with
 /// all physical groups of the .geo. Throws MeshError naming the file on any gmsh error.
 TetMesh mesh_geo(const std::filesystem::path& geo, const std::map<std::string, double>& parameters,
                  double element_size);

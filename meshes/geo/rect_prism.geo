@@ -15,6 +15,9 @@ DefineConstant[
   cut_offset = {(cut_normal == 0) ? length / 2 : 0, Name "Parameters/cut_offset"}
 ];
 
+If (cut_normal != 0 && cut_normal != 1)
+  Error("rect_prism.geo: cut_normal = %g must be 0 (plane x = cut_offset) or 1 (plane y = cut_offset)", cut_normal);
+EndIf
 If (cut_normal == 0)
   If (cut_offset <= 0 || cut_offset >= length)
     Error("rect_prism.geo: cut_offset = %g must lie in (0, length = %g)", cut_offset, length);
