@@ -140,11 +140,15 @@ void set_volume_meshing_options(double h) {
   gmsh::option::setNumber("Mesh.Algorithm3D", 1); // Delaunay
 }
 
+/// Whether extraction orients every tetrahedron positively (gmsh's own meshes, whose orientation
+/// convention is not kerf's) or keeps the file's node order (a mesh read from a file).
+enum class TetOrientation { make_positive, as_stored };
+
 /// Reads the current gmsh model's mesh into a TetMesh: nodes used by a tetrahedron or a physical
 /// triangle, renumbered compactly in ascending gmsh node-tag order; tetrahedra in ascending
-/// element-tag order, each positively oriented; every physical volume (its tetrahedra) and
+/// element-tag order, each positively oriented if `orientation` says so; every physical volume (its tetrahedra) and
 /// physical surface (its triangles, ascending element tag). Unnamed groups: "physical_<tag>".
-TetMesh extract_tet_mesh(const std::string& file) {
+TetMesh extract_tet_mesh(const std::string& file, TetOrientation orientation) {
   std::vector<int> volume_types;
   gmsh::model::mesh::getElementTypes(volume_types, 3);
   for (const int type : volume_types)
@@ -248,7 +252,7 @@ TetMesh extract_tet_mesh(const std::string& file) {
     // Positive orientation det[b - a, c - a, d - a] > 0: swapping two nodes flips the sign.
     const double volume = signed_volume(mesh.nodes.row(mesh.tets(t, 0)).transpose(), mesh.nodes.row(mesh.tets(t, 1)).transpose(),
                                         mesh.nodes.row(mesh.tets(t, 2)).transpose(), mesh.nodes.row(mesh.tets(t, 3)).transpose());
-    if (volume < 0.0) std::swap(mesh.tets(t, 2), mesh.tets(t, 3));
+    if (orientation == TetOrientation::make_positive && volume < 0.0) std::swap(mesh.tets(t, 2), mesh.tets(t, 3));
   }
 
   for (auto& raw : raw_surfaces) {
@@ -330,7 +334,7 @@ TetMesh mesh_geo(const fs::path& geo, const std::map<std::string, double>& param
     set_volume_meshing_options(element_size);
     gmsh::model::mesh::generate(3);
   });
-  return extract_tet_mesh(geo.string());
+  return extract_tet_mesh(geo.string(), TetOrientation::make_positive);
 }
 
 TetMesh mesh_stl(const fs::path& stl, double element_size, double scale) {
@@ -365,7 +369,7 @@ TetMesh mesh_stl(const fs::path& stl, double element_size, double scale) {
     set_volume_meshing_options(element_size / scale);
     gmsh::model::mesh::generate(3);
   });
-  TetMesh mesh = extract_tet_mesh(stl.string());
+  TetMesh mesh = extract_tet_mesh(stl.string(), TetOrientation::make_positive);
   mesh.nodes *= scale;
   return mesh;
 }
@@ -374,7 +378,9 @@ TetMesh read_msh(const fs::path& msh) {
   require_file(msh, ".msh");
   GmshSession session(msh.string());
   session.run("reading", [&] { gmsh::open(fs::absolute(msh).string()); });
-  return extract_tet_mesh(msh.string());
+  // A file is read as written: an inverted element stays inverted, so the quality check of
+  // whoever loads it (scene_mesh) can refuse it instead of silently flipping a broken mesh.
+  return extract_tet_mesh(msh.string(), TetOrientation::as_stored);
 }
 
 namespace {

@@ -25,6 +25,8 @@ TetMesh mesh_geo(const std::filesystem::path& geo, const std::map<std::string, d
 TetMesh mesh_stl(const std::filesystem::path& stl, double element_size, double scale = 1.0);
 
 /// Reads a .msh file (any version gmsh reads) holding first-order tetrahedra and triangles.
+/// Tetrahedra keep the node order of the file: an inverted element stays inverted (the quality
+/// summary reports it; kerf refuses such a mesh when a scene loads it).
 TetMesh read_msh(const std::filesystem::path& msh);
 
 /// Writes .msh 4.1 ASCII with nodes, tetrahedra and physical groups, atomically

@@ -94,7 +94,7 @@ TEST(GmshIo, MshRoundTripOfAHandBuiltMeshWithOverlappingGroups) {
   EXPECT_EQ(back.tets, loose.tets);
 }
 
-TEST(GmshIo, ReadsUnnamedGroupsAndOrientsTetrahedraPositively) {
+TEST(GmshIo, ReadsUnnamedGroupsAndKeepsTheFilesOrientation) {
   // MSH 2.2 written by hand: one inverted tetrahedron (det < 0) in physical volume 7 without a
   // name, one triangle in physical surface 3 without a name.
   const fs::path file = scratch_dir("hand22") / "inverted.msh";
@@ -103,8 +103,10 @@ TEST(GmshIo, ReadsUnnamedGroupsAndOrientsTetrahedraPositively) {
                          "1 4 2 7 1 1 3 2 4\n2 2 2 3 1 1 2 3\n$EndElements\n";
   const TetMesh mesh = read_msh(file);
   ASSERT_EQ(mesh.tets.rows(), 1);
-  // The right-corner tetrahedron: volume 1/6 once oriented.
-  EXPECT_NEAR(mesh_volume(mesh), 1.0 / 6.0, 1e-15);
+  // The right-corner tetrahedron, volume 1/6, stored inverted: read as written (-1/6) so the
+  // quality summary reports it instead of a silently flipped element.
+  EXPECT_NEAR(mesh_volume(mesh), -1.0 / 6.0, 1e-15);
+  EXPECT_EQ(tet_quality_summary(mesh).inverted, 1);
   ASSERT_EQ(mesh.volume_groups.size(), 1U);
   EXPECT_EQ(mesh.volume_groups[0].name, "physical_7");
   ASSERT_EQ(mesh.surface_groups.size(), 1U);
