@@ -89,4 +89,16 @@ TetMesh box_tet_mesh(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
   return mesh;
 }
 
+void add_height_layers(TetMesh& mesh, double interface_z) {
+  VolumeGroup upper{"layer_upper", static_cast<int>(mesh.volume_groups.size()) + 10, {}};
+  VolumeGroup lower{"layer_lower", upper.tag + 1, {}};
+  for (int t = 0; t < mesh.tets.rows(); ++t) {
+    double z = 0.0;
+    for (int v = 0; v < 4; ++v) z += 0.25 * mesh.nodes(mesh.tets(t, v), 2);
+    (z > interface_z ? upper : lower).tets.push_back(t);
+  }
+  mesh.volume_groups.push_back(std::move(upper));
+  mesh.volume_groups.push_back(std::move(lower));
+}
+
 } // namespace kerf

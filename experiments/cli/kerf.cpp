@@ -72,12 +72,7 @@ void print_cutting_check(const Scene& scene, const TetMesh& mesh, const ForcePro
   const ProfileRow& mid = *cutting[cutting.size() / 2];
   const double force = -mid.force.dot(blade.cutting_direction);
 
-  std::vector<std::string> regions;
-  std::vector<double> toughness;
-  if (scene.phenomena.contains(Phenomenon::layers))
-    for (const Material& m : scene.layers) regions.push_back(m.region), toughness.push_back(m.fracture_toughness);
-  else
-    toughness.push_back(scene.material.fracture_toughness);
+  const auto [regions, toughness] = toughness_regions(scene);
   SegmentLengthInBody length(mesh, regions);
   std::vector<double> l(toughness.size());
   const Eigen::Vector3d half = 0.5 * blade.edge_length * blade.edge_direction;

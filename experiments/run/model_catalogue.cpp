@@ -36,14 +36,9 @@ BuiltModel make_fracture_model(const Scene& scene, const TetMesh& mesh) {
   setup.response = *scene.fracture;
   // Only the machinery the scene needs: per-layer lengths for a layered body, friction only if
   // the scene declares it.
-  if (scene.phenomena.contains(Phenomenon::layers)) {
-    for (const Material& layer : scene.layers) {
-      setup.regions.push_back(layer.region);
-      setup.fracture_toughness.push_back(layer.fracture_toughness);
-    }
-  } else {
-    setup.fracture_toughness.push_back(scene.material.fracture_toughness);
-  }
+  ToughnessRegions regions = toughness_regions(scene);
+  setup.regions = std::move(regions.regions);
+  setup.fracture_toughness = std::move(regions.fracture_toughness);
   setup.friction = scene.phenomena.contains(Phenomenon::friction);
   setup.friction_coefficient = setup.friction ? scene.material.friction_coefficient : 0.0;
   setup.crack_capture_width = std::max(blade.thickness, 1e-6);
@@ -71,6 +66,19 @@ BuiltModel make_fracture_model(const Scene& scene, const TetMesh& mesh) {
 }
 
 } // namespace
+
+ToughnessRegions toughness_regions(const Scene& scene) {
+  ToughnessRegions r;
+  if (scene.phenomena.contains(Phenomenon::layers)) {
+    for (const Material& layer : scene.layers) {
+      r.regions.push_back(layer.region);
+      r.fracture_toughness.push_back(layer.fracture_toughness);
+    }
+  } else {
+    r.fracture_toughness.push_back(scene.material.fracture_toughness);
+  }
+  return r;
+}
 
 std::span<const ModelDescription> model_catalogue() { return catalogue; }
 

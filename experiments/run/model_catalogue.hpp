@@ -46,6 +46,14 @@ struct BuiltModel {
 /// missing); returns the model's description.
 const ModelDescription& require_model_for_scene(std::string_view name, const Scene& scene);
 
+/// The regions of a scene's body and the fracture toughness of each: one per layer (volume group
+/// names) for a layered scene, else one unnamed region (the whole mesh) with the material's J_c.
+struct ToughnessRegions {
+  std::vector<std::string> regions;
+  std::vector<double> fracture_toughness; ///< [J/m^2]
+};
+ToughnessRegions toughness_regions(const Scene& scene);
+
 /// Builds model `name` for `scene` on its mesh (after require_model_for_scene). Throws ModelMismatch when the model cannot
 /// represent a phenomenon the scene declares, or lacks a tool or parameter section it needs —
 /// naming what is missing — and std::invalid_argument for an unknown model name.

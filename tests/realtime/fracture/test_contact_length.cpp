@@ -65,14 +65,7 @@ TEST(ContactLength, PerRegionLengthsOfALayeredBox) {
   // Two regions split at z = 9 mm (a grid plane for nz = 5): a vertical segment through the
   // whole depth has 9 mm in the lower region and 6 mm in the upper one.
   TetMesh mesh = box_tet_mesh(lower, upper, 4, 2, 5);
-  VolumeGroup up{"layer_upper", 10, {}}, down{"layer_lower", 11, {}};
-  for (int t = 0; t < mesh.tets.rows(); ++t) {
-    double z = 0.0;
-    for (int v = 0; v < 4; ++v) z += mesh.nodes(mesh.tets(t, v), 2) / 4.0;
-    (z > 0.009 ? up : down).tets.push_back(t);
-  }
-  mesh.volume_groups.push_back(up);
-  mesh.volume_groups.push_back(down);
+  add_height_layers(mesh, 0.009);
   SegmentLengthInBody length(mesh, {"layer_upper", "layer_lower"});
   double l[2];
   const double total = length.lengths({0.013, 0.001, -0.01}, {0.013, 0.001, 0.03}, l);

@@ -218,14 +218,7 @@ TEST(FractureCuttingModel, TwoLayersSumTheirToughness) {
   // §6: a body of two layers; the edge is horizontal, so at each depth it lies in one layer:
   // the cutting force is J_upper l above the interface and J_lower l below it.
   TetMesh mesh = box_tet_mesh({0.0, -0.010, 0.0}, {0.040, 0.010, 0.015}, 8, 4, 5); // interface z = 9 mm
-  VolumeGroup up{"layer_upper", 10, {}}, down{"layer_lower", 11, {}};
-  for (int t = 0; t < mesh.tets.rows(); ++t) {
-    double z = 0.0;
-    for (int v = 0; v < 4; ++v) z += mesh.nodes(mesh.tets(t, v), 2) / 4.0;
-    (z > 0.009 ? up : down).tets.push_back(t);
-  }
-  mesh.volume_groups.push_back(up);
-  mesh.volume_groups.push_back(down);
+  add_height_layers(mesh, 0.009);
   FractureCuttingSetup setup = razor();
   setup.regions = {"layer_upper", "layer_lower"};
   setup.fracture_toughness = {600.0, 200.0};
