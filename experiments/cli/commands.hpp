@@ -1,0 +1,20 @@
+#pragma once
+// The kerf command line: one file per subcommand, each adding itself to the application. A
+// subcommand's callback does the work and throws on failure; main() maps exceptions to exit codes.
+
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <string>
+
+namespace kerf::cli {
+
+/// A scene argument is a path to a .toml file, or the name of a scene in experiments/scenes.
+/// Throws SceneError if it is neither.
+std::filesystem::path resolve_scene(const std::string& argument);
+
+void add_mesh_command(CLI::App& app);   ///< kerf mesh SCENE [-o DIR]
+void add_run_command(CLI::App& app);    ///< kerf run SCENE --model M [-o DIR]
+void add_models_command(CLI::App& app); ///< kerf models
+
+} // namespace kerf::cli
