@@ -1,0 +1,13 @@
+#pragma once
+// How each model is checked against a scene and built from it. One pair of functions per model,
+// each pair in its own file (`*_builder.cpp`); the catalogue (model_catalogue.cpp) lists them.
+
+#include "experiments/run/model_catalogue.hpp"
+
+namespace kerf {
+
+/// Paper 001, realtime/fracture (fracture_builder.cpp).
+void require_fracture_inputs(const Scene& scene);
+BuiltModel build_fracture_model(const Scene& scene, const TetMesh& mesh);
+
+} // namespace kerf
