@@ -1,0 +1,146 @@
+#include "experiments/study/study_table.hpp"
+
+#include "meshes/atomic_file.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <stdexcept>
+
+namespace kerf {
+
+namespace {
+/// "name [unit]", or "name" without a unit.
+std::string header(const StudyTable::Column& c) {
+  std::string h = c.name;
+  if (!c.unit.empty()) {
+    h += " [";
+    h += c.unit;
+    h += ']';
+  }
+  return h;
+}
+
+std::string latex_escape(const std::string& s) {
+  std::string out;
+  for (char ch : s) {
+    switch (ch) {
+    case '&': case '%': case '$': case '#': case '_': case '{': case '}': out += '\\'; out += ch; break;
+    case '~': out += "\\textasciitilde{}"; break;
+    case '^': out += "\\textasciicircum{}"; break;
+    case '\\': out += "\\textbackslash{}"; break;
+    default: out += ch;
+    }
+  }
+  return out;
+}
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char ch : s) out += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return out + "\"";
+}
+} // namespace
+
+StudyTable::StudyTable(std::vector<Column> columns) : m_columns(std::move(columns)) {
+  if (m_columns.empty()) throw std::invalid_argument("study table: no columns");
+}
+
+void StudyTable::add_row(std::vector<Cell> row) {
+  if (row.size() != m_columns.size())
+    throw std::invalid_argument("study table: a row has " + std::to_string(row.size()) + " cells for " +
+                                std::to_string(m_columns.size()) + " columns");
+  m_rows.push_back(std::move(row));
+}
+
+std::string StudyTable::shown(std::size_t column, const Cell& cell) const {
+  if (const auto* text = std::get_if<std::string>(&cell)) return *text;
+  const auto& number = std::get<std::optional<double>>(cell);
+  if (!number) return "–";
+  const double v = *number * m_columns[column].scale;
+  if (!std::isfinite(v)) return std::isnan(v) ? "NaN" : (v > 0 ? "∞" : "-∞");
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*g", m_columns[column].significant_digits, v);
+  return buffer;
+}
+
+std::string StudyTable::markdown() const {
+  std::string out = "|";
+  for (const Column& c : m_columns) {
+    out += ' ';
+    out += header(c);
+    out += " |";
+  }
+  out += "\n|";
+  for (std::size_t c = 0; c < m_columns.size(); ++c) out += std::holds_alternative<std::string>(m_rows.empty() ? Cell{std::string{}} : m_rows.front()[c]) ? "---|" : "---:|";
+  out += "\n";
+  for (const auto& row : m_rows) {
+    out += "|";
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      out += ' ';
+      out += shown(c, row[c]);
+      out += " |";
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+
+std::string StudyTable::latex() const {
+  std::string spec;
+  for (std::size_t c = 0; c < m_columns.size(); ++c)
+    spec += (!m_rows.empty() && std::holds_alternative<std::string>(m_rows.front()[c])) ? "l" : "r";
+  std::string out = "\\begin{tabular}{" + spec + "}\n\\toprule\n";
+  for (std::size_t c = 0; c < m_columns.size(); ++c) {
+    if (c) out += " & ";
+    out += latex_escape(header(m_columns[c]));
+  }
+  out += " \\\\\n\\midrule\n";
+  for (const auto& row : m_rows) {
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      const std::string cell = shown(c, row[c]);
+      if (c) out += " & ";
+      out += cell == "–" ? std::string("--") : latex_escape(cell);
+    }
+    out += " \\\\\n";
+  }
+  return out + "\\bottomrule\n\\end{tabular}\n";
+}
+
+std::string StudyTable::csv() const {
+  std::string out;
+  for (std::size_t c = 0; c < m_columns.size(); ++c) {
+    if (c) out += ',';
+    out += csv_field(header(m_columns[c]));
+  }
+  out += "\n";
+  for (const auto& row : m_rows) {
+    for (std::size_t c = 0; c < row.size(); ++c) {
+      if (c) out += ",";
+      if (const auto* text = std::get_if<std::string>(&row[c])) {
+        out += csv_field(*text);
+      } else if (const auto& number = std::get<std::optional<double>>(row[c])) {
+        char buffer[64];
+        std::snprintf(buffer, sizeof buffer, "%.17g", *number * m_columns[c].scale);
+        out += buffer;
+      }
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+void StudyTable::write(const std::filesystem::path& directory, const std::string& name) const {
+  const std::pair<const char*, std::string> forms[] = {{".md", markdown()}, {".tex", latex()}, {".csv", csv()}};
+  for (const auto& [extension, text] : forms)
+    write_atomically(directory / (name + extension), [&](const std::filesystem::path& tmp) {
+      std::ofstream out(tmp, std::ios::binary);
+      out << text;
+      out.flush();
+      if (!out) throw std::runtime_error((directory / (name + extension)).string() + ": write failed");
+    });
+}
+
+} // namespace kerf
