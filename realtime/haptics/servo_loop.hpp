@@ -1,0 +1,130 @@
+#pragma once
+// The haptic servo loop (docs/haptic-rig.md): a thread at a fixed rate that sleeps to absolute
+// deadlines (clock_nanosleep, TIMER_ABSTIME, CLOCK_MONOTONIC), reads every device, steps the model
+// (or, when the model runs slower than the device, renders the model thread's force by linear
+// interpolation), passes each force through that device's SafetyLayer, commands the devices,
+// observes the energy injected (passivity observer) and records the tick. Everything the tick
+// touches is allocated before the first tick.
+//
+// Device i drives tool i of the model: the model's tool_count() must equal the device count.
+
+#include "realtime/haptics/haptic_device.hpp"
+#include "realtime/haptics/realtime_scheduling.hpp"
+#include "realtime/haptics/safety_layer.hpp"
+#include "realtime/haptics/session_recorder.hpp"
+#include "realtime/haptics/timing_statistics.hpp"
+#include "realtime/haptics/triple_buffer.hpp"
+#include "realtime/tool_model.hpp"
+
+#include <atomic>
+#include <span>
+#include <vector>
+
+namespace kerf {
+
+/// Settings of one session.
+struct ServoSettings {
+  double rate = 1000.0;       ///< servo (device) rate [Hz], 100 to 10000
+  double model_rate = 0.0;    ///< 0: the model steps in the servo thread; else its own thread at this rate [Hz] < rate
+  double duration = 0.0;      ///< [s] from the start of the loop until the ramp out begins; 0: until stopped
+  SafetyLimits safety;        ///< applied to every device
+  bool realtime = true;       ///< try SCHED_FIFO and mlockall (falls back with a warning)
+  int priority = 80;          ///< SCHED_FIFO priority of the servo thread (the model thread gets one less)
+};
+
+/// What a session did.
+struct ServoReport {
+  RealtimeSetup realtime;
+  TimingStatistics timing;                 ///< of the servo thread
+  TimingStatistics model_timing;           ///< of the model thread (multi-rate only)
+  std::vector<LinkCounters> links;         ///< per device
+  std::vector<SafetyCounters> safety;      ///< per device
+  std::vector<double> injected_energy;     ///< per device: passivity observer [J]
+  std::uint64_t model_steps = 0;
+  std::uint64_t records_dropped = 0;       ///< ticks the recorder's ring could not take
+  bool emergency_stopped = false;
+};
+
+class ServoLoop {
+public:
+  /// Checks the settings and the tool/device count (std::invalid_argument naming what is
+  /// wrong) and allocates everything the ticks use. `recorder` may be null.
+  ServoLoop(ToolModel& model, std::span<HapticDevice* const> devices, const ServoSettings& settings,
+            SessionRecorder* recorder);
+  ServoLoop(const ServoLoop&) = delete;
+  ServoLoop& operator=(const ServoLoop&) = delete;
+
+  /// Runs the session on its own thread(s) and returns when it has ended: after the duration
+  /// and the ramp out, after request_stop() and the ramp out, or at once after an emergency stop.
+  ServoReport run();
+
+  /// Ends the session with a ramp out. Async-signal-safe (one atomic store).
+  void request_stop() noexcept { m_stop_requested.store(true, std::memory_order_relaxed); }
+  /// Zeroes every force at the next tick and ends the session. Async-signal-safe.
+  void request_emergency_stop() noexcept { m_emergency_requested.store(true, std::memory_order_relaxed); }
+
+  /// One servo tick at rig time `now` [s] since the loop started, woken `late` [s] after its
+  /// deadline. Allocation-free. Returns false once the session has ended. (run() calls this;
+  /// tests may call it directly, in single-rate mode.)
+  bool tick(double now, double late) noexcept;
+
+  [[nodiscard]] const TimingStatistics& timing() const noexcept { return m_timing; }
+  [[nodiscard]] const SafetyLayer& safety(std::size_t device) const { return m_safety.at(device); }
+  [[nodiscard]] double injected_energy(std::size_t device) const { return m_injected.at(device); }
+  [[nodiscard]] std::uint64_t model_steps() const noexcept { return m_model_steps; }
+
+private:
+  /// What the model thread publishes (multi-rate).
+  struct ModelOutput {
+    double time = -1.0;   ///< rig time of the positions it stepped at [s]
+    double compute = 0.0; ///< [s]
+    std::array<ForceSample, max_session_tools> forces{};
+  };
+  /// What the servo publishes to the model thread (multi-rate).
+  struct ModelInput {
+    double time = -1.0;
+    std::array<ToolState, max_session_tools> tools{};
+  };
+
+  void servo_thread();
+  void model_thread();
+  void step_model(std::span<const ToolState> tools, double dt, std::span<ForceSample> out, double& compute) noexcept;
+
+  ToolModel& m_model;
+  std::vector<HapticDevice*> m_devices;
+  ServoSettings m_settings;
+  SessionRecorder* m_recorder;
+  std::size_t m_count;
+  double m_period;
+
+  std::vector<SafetyLayer> m_safety;
+  std::vector<ToolState> m_tools;
+  std::vector<ForceSample> m_forces;
+  std::vector<Eigen::Vector3d> m_previous_position;
+  std::vector<Eigen::Vector3d> m_previous_force;
+  std::vector<double> m_injected;
+  TimingStatistics m_timing;
+  TimingStatistics m_model_timing;
+  TickRecord m_record;
+
+  bool m_active = false;
+  bool m_stopping = false;
+  bool m_emergency = false;
+  int m_final_ticks = 0;
+  double m_last_now = 0.0;
+  bool m_finished = false;
+  std::uint64_t m_model_steps = 0;
+  std::atomic<bool> m_stop_requested{false};
+  std::atomic<bool> m_emergency_requested{false};
+  std::atomic<bool> m_model_thread_done{false};
+
+  // Multi-rate: the latest positions for the model thread, and its last two outputs for
+  // interpolation (previous and newest).
+  TripleBuffer<ModelInput> m_to_model;
+  TripleBuffer<ModelOutput> m_from_model;
+  ModelOutput m_model_previous;
+  ModelOutput m_model_newest;
+  RealtimeSetup m_realtime;
+};
+
+} // namespace kerf

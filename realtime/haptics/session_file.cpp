@@ -1,0 +1,140 @@
+#include "realtime/haptics/session_file.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace kerf {
+
+namespace {
+
+std::vector<std::string> split(const std::string& s, char separator) {
+  std::vector<std::string> out;
+  std::string field;
+  std::stringstream in(s);
+  while (std::getline(in, field, separator)) out.push_back(field);
+  if (!s.empty() && s.back() == separator) out.emplace_back();
+  return out;
+}
+
+} // namespace
+
+Session read_session(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error(file.string() + ": cannot open the session file");
+  std::stringstream whole;
+  whole << in.rdbuf();
+  std::string text = whole.str();
+  // An append-only file cut by a crash may end in a partial row: keep complete lines only.
+  if (const auto last = text.find_last_of('\n'); last == std::string::npos) text.clear();
+  else text.resize(last + 1);
+
+  Session session;
+  std::stringstream lines(text);
+  std::string line;
+  int number = 0;
+  auto fail = [&](const std::string& what) {
+    throw std::runtime_error(file.string() + ":" + std::to_string(number) + ": " + what);
+  };
+  auto number_at = [&](const std::string& field, const char* column) {
+    char* end = nullptr;
+    const double v = std::strtod(field.c_str(), &end);
+    if (field.empty() || *end != '\0' || !std::isfinite(v))
+      fail(std::string("column ") + column + ": expected a finite number, found \"" + field + "\"");
+    return v;
+  };
+
+  const std::vector<std::string> columns = split(session_csv_header, ',');
+  TickRecord current;
+  bool open = false;
+  while (std::getline(lines, line)) {
+    ++number;
+    if (number == 1) {
+      if (line != "# kerf haptic session v1") fail("not a kerf haptic session (expected \"# kerf haptic session v1\")");
+      continue;
+    }
+    if (number == 2) {
+      std::stringstream words(line.substr(line.rfind('#', 0) == 0 ? 1 : 0));
+      std::string word;
+      while (words >> word) {
+        const auto eq = word.find('=');
+        if (eq == std::string::npos) continue;
+        const std::string key = word.substr(0, eq), value = word.substr(eq + 1);
+        if (key == "rate_hz") session.header.rate = number_at(value, "rate_hz");
+        else if (key == "model") session.header.model = value;
+        else if (key == "scene") session.header.scene = value;
+        else if (key == "tools") session.header.tools = split(value, ';');
+      }
+      if (!(session.header.rate > 0.0)) fail("header: rate_hz missing or not positive");
+      if (session.header.tools.empty() || session.header.tools.size() > static_cast<std::size_t>(max_session_tools))
+        fail("header: tools must name 1 to " + std::to_string(max_session_tools) + " tools");
+      continue;
+    }
+    if (number == 3) {
+      if (line != session_csv_header) fail(std::string("expected the header \"") + session_csv_header + "\"");
+      continue;
+    }
+    const std::vector<std::string> f = split(line, ',');
+    if (f.size() != columns.size())
+      fail("expected " + std::to_string(columns.size()) + " columns, found " + std::to_string(f.size()));
+    const auto tick = static_cast<std::uint64_t>(number_at(f[0], "tick"));
+    int tool = -1;
+    for (std::size_t k = 0; k < session.header.tools.size(); ++k)
+      if (session.header.tools[k] == f[2]) tool = static_cast<int>(k);
+    if (tool < 0) fail("unknown tool \"" + f[2] + "\"");
+    if (open && tick != current.tick) {
+      if (current.tools != static_cast<int>(session.header.tools.size())) fail("a tick is missing a tool's row");
+      if (tick < current.tick) fail("ticks out of order");
+      session.ticks.push_back(current);
+      open = false;
+    }
+    if (!open) {
+      current = TickRecord{};
+      current.tick = tick;
+      current.t = number_at(f[1], "t");
+      current.compute = number_at(f[22], "compute_s");
+      current.late = number_at(f[23], "late_s");
+      open = true;
+    }
+    if (tool != current.tools) fail("tool rows of a tick out of order");
+    ToolTick& k = current.tool[static_cast<std::size_t>(tool)];
+    for (int c = 0; c < 3; ++c) {
+      k.position[c] = number_at(f[3 + static_cast<std::size_t>(c)], "p");
+      k.velocity[c] = number_at(f[6 + static_cast<std::size_t>(c)], "v");
+      k.model_force[c] = number_at(f[14 + static_cast<std::size_t>(c)], "model_f");
+      k.force[c] = number_at(f[17 + static_cast<std::size_t>(c)], "f");
+    }
+    for (int c = 0; c < 4; ++c) k.orientation[c] = number_at(f[9 + static_cast<std::size_t>(c)], "q");
+    k.buttons = static_cast<std::uint32_t>(number_at(f[13], "buttons"));
+    const auto mode = interaction_mode_from_string(f[20]);
+    if (!mode) fail("unknown mode \"" + f[20] + "\"");
+    k.mode = *mode;
+    k.crack_extent = number_at(f[21], "crack_extent");
+    k.link_age = number_at(f[24], "link_age_s");
+    k.status = static_cast<std::uint32_t>(number_at(f[25], "status"));
+    k.injected = number_at(f[26], "injected_j");
+    ++current.tools;
+  }
+  if (number < 3) throw std::runtime_error(file.string() + ": the session file has no header");
+  // A last tick cut by a crash (some tool rows missing) is dropped like a partial line.
+  if (open && current.tools == static_cast<int>(session.header.tools.size())) session.ticks.push_back(current);
+  return session;
+}
+
+std::vector<std::vector<ToolState>> session_tool_states(const Session& session) {
+  std::vector<std::vector<ToolState>> out(session.header.tools.size());
+  for (auto& tool : out) tool.reserve(session.ticks.size());
+  for (const TickRecord& r : session.ticks)
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      ToolState s;
+      s.position = r.tool[i].position;
+      s.velocity = r.tool[i].velocity;
+      s.time = r.t;
+      out[i].push_back(s);
+    }
+  return out;
+}
+
+} // namespace kerf
