@@ -29,7 +29,7 @@ using namespace kerf;
 namespace {
 
 std::filesystem::path session_file(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "kerf_test_loopback";
+  const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_loopback_" + std::to_string(getpid())); // per process: parallel ctest runs
   std::filesystem::create_directories(dir);
   return dir / name;
 }

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <unistd.h>
 #include <fstream>
 
 using namespace kerf;
@@ -14,7 +15,7 @@ using namespace kerf;
 namespace {
 
 std::filesystem::path temp_file(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / "kerf_test_session";
+  const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_session_" + std::to_string(getpid())); // per process: parallel ctest runs
   std::filesystem::create_directories(dir);
   return dir / name;
 }
