@@ -19,6 +19,11 @@ const CatalogueEntry catalogue[] = {
       PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction, Phenomenon::layers},
       "one blade"},
      &require_fracture_inputs, &build_fracture_model},
+    {{"edge", "discretised blade edge: stiffness x disparity per point, shear-limited cutting resistance, friction, drag; voxel collision",
+      "paper 000 §3.1, §3.3",
+      PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction, Phenomenon::layers},
+      "one blade"},
+     &require_edge_inputs, &build_edge_model},
 };
 
 const std::vector<ModelDescription> descriptions = [] {
