@@ -16,5 +16,6 @@ std::filesystem::path resolve_scene(const std::string& argument);
 void add_mesh_command(CLI::App& app);   ///< kerf mesh SCENE [-o DIR]
 void add_run_command(CLI::App& app);    ///< kerf run SCENE --model M [-o DIR]
 void add_models_command(CLI::App& app); ///< kerf models
+void add_stability_command(CLI::App& app); ///< kerf stability SCENE --model M [-o DIR]
 
 } // namespace kerf::cli
