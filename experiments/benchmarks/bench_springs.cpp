@@ -1,0 +1,77 @@
+// Cost of the spring network (paper 000 §2): one 1 ms servo sample against N (N^3 cells) for
+// each integrator, and the embedding of 10^4 .. 10^6 fine nodes (trilinear and Coons).
+// Run: build/experiments/benchmarks/bench_springs --benchmark_min_time=0.2
+
+#include "meshes/box_tet_mesh.hpp"
+#include "realtime/springs/network_embedding.hpp"
+#include "realtime/springs/spring_network_model.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <random>
+
+namespace {
+
+using namespace kerf;
+
+/// A clay cube of side N x 2.5 mm (the scenes' material) whose whole volume is the network
+/// (cells = N), base bonded, a 2 mm stylus on the top centre pulled up and down by 0.1 mm.
+void step_cost(benchmark::State& state, SpringIntegrator integrator) {
+  const int n = static_cast<int>(state.range(0));
+  const double side = 2.5e-3 * n;
+  const TetMesh mesh = box_tet_mesh({0.0, 0.0, 0.0}, {side, side, side}, n, n, n);
+  SpringNetworkSetup s;
+  s.youngs_modulus = 0.5e6;
+  s.poisson_ratio = 0.45;
+  s.density = 1700.0;
+  s.damping = 10.0;
+  s.cells = n;
+  s.integrator = integrator;
+  s.supports = {{"support", false}};
+  s.styluses = {{Eigen::Vector3d(side / 2, side / 2, side + 2e-3), 2e-3}};
+  SpringNetworkModel model(mesh, s);
+  std::array<ToolState, 1> tool;
+  std::array<ForceSample, 1> force;
+  long k = 0;
+  for (auto _ : state) {
+    const double phase = static_cast<double>(k++ % 200) / 200.0;
+    tool[0].position = s.styluses[0].start + Eigen::Vector3d(0, 0, 1e-4 * std::sin(6.283185307179586 * phase));
+    model.step(tool, 1e-3, force);
+    benchmark::DoNotOptimize(force[0].force.data());
+  }
+  state.counters["cells"] = model.network().cell_count();
+  state.counters["substeps_or_iterations"] = model.last_substeps();
+}
+
+void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
+  const int n = 8;
+  const double h = 2.5e-3;
+  NetworkBlock block;
+  block.cell_size = h;
+  block.cells = Eigen::Vector3i::Constant(n);
+  const SpringNetwork net = build_spring_network(block, std::vector<bool>(n * n * n, true),
+                                                 identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0, 0.0);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(0.0, n * h);
+  Eigen::MatrixXd points(state.range(0), 3);
+  for (Eigen::Index p = 0; p < points.rows(); ++p) points.row(p) << u(rng), u(rng), u(rng);
+  const NetworkEmbedding embedding(net, points, scheme);
+  Eigen::Matrix3Xd x = net.rest;
+  for (int q = 0; q < net.node_count; ++q) x(2, q) += 1e-4 * std::sin(x(0, q) * 400.0);
+  Eigen::MatrixXd out(points.rows(), 3);
+  for (auto _ : state) {
+    embedding.apply(net, x, out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["nodes_per_s"] = benchmark::Counter(static_cast<double>(points.rows()), benchmark::Counter::kIsIterationInvariantRate);
+}
+
+} // namespace
+
+BENCHMARK_CAPTURE(step_cost, explicit, SpringIntegrator::symplectic_euler)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, implicit, SpringIntegrator::implicit_euler)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, static, SpringIntegrator::quasi_static)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(embedding_cost, trilinear, EmbeddingScheme::trilinear)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(embedding_cost, coons, EmbeddingScheme::coons)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,68 @@
+// The spring-network model (paper 000 §2) built from a scene: one or two sphere styluses, the
+// material's E, ν, ρ and damping, the scene's supports, tearing (at the material's cohesive
+// strength) only if the scene declares it. Model option "integrator": explicit (default),
+// implicit or static.
+
+#include "experiments/run/model_builders.hpp"
+#include "realtime/springs/spring_network_model.hpp"
+
+namespace kerf {
+
+void require_springs_inputs(const Scene& scene) {
+  if (scene.tools.empty() || scene.tools.size() > 2)
+    throw ModelMismatch("model springs needs one or two sphere (stylus) tools; scene " + scene.name + " has " +
+                        std::to_string(scene.tools.size()));
+  for (const Tool& t : scene.tools)
+    if (t.kind != Tool::Kind::sphere)
+      throw ModelMismatch("model springs takes sphere (stylus) tools only (paper 000 §2: the stylus tip grasps the "
+                          "body); tool \"" + t.name + "\" of scene " + scene.name + " is a blade");
+  if (scene.phenomena.contains(Phenomenon::tearing) && !(scene.material.cohesive_strength > 0.0))
+    throw ModelMismatch("model springs tears at the material's cohesive_strength, which scene " + scene.name + " does not give");
+}
+
+BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const ModelOptions& options) {
+  SpringNetworkSetup setup;
+  for (const auto& [key, value] : options) {
+    if (key != "integrator")
+      throw std::invalid_argument("model springs: unknown option \"" + key + "\" (known: integrator)");
+    const auto integrator = spring_integrator_from_string(value);
+    if (!integrator)
+      throw std::invalid_argument("model springs: integrator \"" + value + "\" is not one of explicit, implicit, static");
+    setup.integrator = *integrator;
+  }
+  const Material& m = scene.material;
+  setup.youngs_modulus = m.youngs_modulus;
+  setup.poisson_ratio = m.poisson_ratio;
+  setup.density = m.density;
+  setup.damping = m.damping;
+  setup.tearing = scene.phenomena.contains(Phenomenon::tearing);
+  setup.tensile_limit = setup.tearing ? m.cohesive_strength : 0.0;
+  for (const Support& s : scene.supports) setup.supports.push_back({s.surface, s.kind == Support::Kind::sliding});
+  for (const Tool& t : scene.tools) setup.styluses.push_back({t.trajectory.start, t.radius});
+
+  auto model = std::make_unique<SpringNetworkModel>(mesh, setup);
+  const SpringNetwork& net = model->network();
+  const CellIdentification& id = model->identification();
+  nlohmann::json p;
+  p["integrator"] = std::string(to_string(setup.integrator));
+  p["cells_per_side"] = setup.cells;
+  p["cell_size_m"] = net.block.cell_size;
+  p["block_origin_m"] = nlohmann::json::array({net.block.origin.x(), net.block.origin.y(), net.block.origin.z()});
+  p["kept_cells"] = net.cell_count();
+  p["nodes"] = net.node_count;
+  p["spring_constants_N_per_m"] = {{"edge", id.stiffness.edge}, {"face_diagonal", id.stiffness.face_diagonal},
+                                   {"body_diagonal", id.stiffness.body_diagonal}};
+  p["volume_modulus_Pa"] = id.stiffness.volume_modulus;
+  p["network_poisson_ratio"] = id.poisson_ratio;
+  p["bulk_modulus_error"] = id.bulk_modulus_error;
+  p["damping_time_s"] = net.damping_time;
+  p["explicit_stability_limit_s"] = model->stability_limit();
+  std::vector<int> attached;
+  for (int t = 0; t < model->tool_count(); ++t) attached.push_back(model->attached_nodes(t));
+  p["attached_nodes"] = attached;
+  p["tearing"] = setup.tearing;
+  if (setup.tearing) p["tensile_limit_Pa"] = setup.tensile_limit;
+  return {std::move(model), std::move(p)};
+}
+
+} // namespace kerf

@@ -1,0 +1,96 @@
+#include "realtime/springs/newton_stepper.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace kerf {
+
+NewtonStepper::NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations)
+    : m_mode(mode), m_max_iterations(max_iterations) {
+  if (max_iterations < 1) throw std::invalid_argument("NewtonStepper: max_iterations must be >= 1");
+  rebuild(net);
+}
+
+void NewtonStepper::rebuild(const SpringNetwork& net) {
+  m_system.rebuild(net);
+  const int cap = net.node_capacity();
+  m_x0.setZero(3, cap);
+  m_v0.setZero(3, cap);
+  m_f.setZero(3, cap);
+  m_zero.setZero(3, cap);
+  m_r.setZero(m_system.dof_count());
+  m_dx.setZero(m_system.dof_count());
+  m_factor_dt = -1.0;
+  // Quasi-static regulariser: 1e-8 of the stiffness-to-mass scale k₁ / (cell mass / 8).
+  m_static_regularisation = 1e-8 * net.stiffness.edge / (net.cell_mass / 8.0);
+}
+
+bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
+  if (m_mode == Mode::implicit_euler)
+    m_system.assemble(net, x, 1.0 / (dt * dt), 1.0 + net.damping_time / dt);
+  else
+    m_system.assemble(net, x, m_static_regularisation, 1.0);
+  m_factor_dt = dt;
+  return m_system.factorize();
+}
+
+double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
+                               double dt) noexcept {
+  const auto& dof = m_system.dof_of();
+  for (int p = 0; p < net.node_count; ++p)
+    for (int i = 0; i < 3; ++i)
+      if (dof[static_cast<std::size_t>(3 * p + i)] >= 0)
+        v(i, p) = m_mode == Mode::implicit_euler ? (x(i, p) - m_x0(i, p)) / dt : 0.0;
+  // Quasi-static equilibrium has no damping: forces at zero velocity.
+  network_forces(net, x, m_mode == Mode::implicit_euler ? v : m_zero, m_f);
+  double norm = 0.0;
+  for (int p = 0; p < net.node_count; ++p)
+    for (int i = 0; i < 3; ++i)
+      if (const int d = dof[static_cast<std::size_t>(3 * p + i)]; d >= 0) {
+        // implicit: r = M (x − xₙ − h vₙ)/h² − f;  quasi-static: r = −f
+        double r = -m_f(i, p);
+        if (m_mode == Mode::implicit_euler)
+          r += net.mass[static_cast<std::size_t>(p)] * (x(i, p) - m_x0(i, p) - dt * m_v0(i, p)) / (dt * dt);
+        m_r[d] = r;
+        norm = std::max(norm, std::abs(r));
+      }
+  return norm;
+}
+
+NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
+                                    double dt) noexcept {
+  NewtonReport report;
+  const int n = net.node_count;
+  m_x0.leftCols(n) = x.leftCols(n);
+  m_v0.leftCols(n) = v.leftCols(n);
+  const auto& dof = m_system.dof_of();
+  // Warm start: the implicit step starts from the explicit predictor xₙ + h vₙ.
+  if (m_mode == Mode::implicit_euler)
+    for (int p = 0; p < n; ++p)
+      for (int i = 0; i < 3; ++i)
+        if (dof[static_cast<std::size_t>(3 * p + i)] >= 0) x(i, p) += dt * v(i, p);
+  if (m_mode == Mode::implicit_euler ? m_factor_dt != dt : m_factor_dt < 0.0) {
+    if (!refactor(net, x, dt)) return report;
+    ++report.factorisations;
+  }
+  const double tolerance = 1e-9 * net.stiffness.edge * net.block.cell_size;
+  double norm = residual(net, x, v, dt);
+  double previous = INFINITY;
+  for (; report.iterations < m_max_iterations && norm > tolerance; ++report.iterations) {
+    if (norm > 0.25 * previous) { // the kept factorisation no longer converges fast: refresh it
+      if (!refactor(net, x, dt)) break;
+      ++report.factorisations;
+    }
+    m_system.solve(m_r, m_dx);
+    for (int p = 0; p < n; ++p)
+      for (int i = 0; i < 3; ++i)
+        if (const int d = dof[static_cast<std::size_t>(3 * p + i)]; d >= 0) x(i, p) -= m_dx[d];
+    previous = norm;
+    norm = residual(net, x, v, dt);
+  }
+  report.residual = norm;
+  report.converged = norm <= tolerance;
+  return report;
+}
+
+} // namespace kerf

@@ -1,0 +1,55 @@
+#pragma once
+// NewtonStepper: the network's implicit Euler step and its quasi-static equilibrium, both solved
+// by Newton's method on the free degrees of freedom with a sparse LDLᵀ factorisation that is
+// kept while it still converges (modified Newton) and refreshed when it does not.
+
+#include "realtime/springs/network_system.hpp"
+#include "realtime/springs/spring_network.hpp"
+
+namespace kerf {
+
+/// What one `advance` did.
+struct NewtonReport {
+  int iterations = 0;
+  int factorisations = 0;
+  bool converged = false;
+  double residual = 0.0; ///< final max-norm of the residual [N]
+};
+
+class NewtonStepper {
+public:
+  enum class Mode {
+    /// Backward Euler: M (x − xₙ − h vₙ)/h² = f(x, (x − xₙ)/h), v = (x − xₙ)/h.
+    implicit_euler,
+    /// Static equilibrium f(x, 0) = 0 per call (inertia and damping left out), v = 0.
+    quasi_static
+  };
+
+  /// Builds the system's pattern for `net` (allocates). `max_iterations` >= 1 per advance.
+  NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations);
+
+  /// Re-analyses after the network's cells, nodes or constraints changed (a tear). Allocates.
+  void rebuild(const SpringNetwork& net);
+
+  /// Advances (x, v) by dt [s]. On entry the free axes hold the state at tₙ and the fixed axes
+  /// their prescribed end-of-step positions and velocities. The residual tolerance is 10⁻⁹ k₁ h
+  /// [N]. The Jacobian A = M/h² + (1 + τ/h) K_T (implicit) or K_T + 10⁻⁸ (‖K‖/‖M‖) M (quasi-static; the
+  /// small mass term only regularises floating pieces and leaves the solution unchanged) is
+  /// factorised on the first call, when dt changes, and whenever an iteration reduces the
+  /// residual by less than a factor 4. Allocation-free.
+  NewtonReport advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+
+private:
+  bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
+  double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+
+  Mode m_mode;
+  int m_max_iterations;
+  NetworkSystem m_system;
+  double m_factor_dt = -1.0;
+  double m_static_regularisation = 0.0;
+  Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero;
+  Eigen::VectorXd m_r, m_dx;
+};
+
+} // namespace kerf

@@ -1,0 +1,194 @@
+#include "realtime/springs/spring_network.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace kerf {
+
+const std::array<CellSpring, 28> cell_springs = [] {
+  std::array<CellSpring, 28> s{};
+  int n = 0;
+  for (int a = 0; a < 8; ++a)
+    for (int b = a + 1; b < 8; ++b) s[n++] = {a, b, __builtin_popcount(static_cast<unsigned>(a ^ b))};
+  return s;
+}();
+
+namespace {
+/// s_a: the sign vector of local corner a, (2bx − 1, 2by − 1, 2bz − 1).
+Eigen::Vector3d corner_sign(int a) { return {2.0 * (a & 1) - 1.0, 2.0 * ((a >> 1) & 1) - 1.0, 2.0 * ((a >> 2) & 1) - 1.0}; }
+
+Eigen::Matrix3d cofactor(const Eigen::Matrix3d& F) {
+  Eigen::Matrix3d c;
+  c.col(0) = F.col(1).cross(F.col(2));
+  c.col(1) = F.col(2).cross(F.col(0));
+  c.col(2) = F.col(0).cross(F.col(1));
+  return c;
+}
+} // namespace
+
+double SpringNetwork::rest_length(int type) const { return block.cell_size * std::sqrt(static_cast<double>(type)); }
+
+double SpringNetwork::spring_constant(int type) const {
+  return type == 1 ? stiffness.edge : type == 2 ? stiffness.face_diagonal : stiffness.body_diagonal;
+}
+
+int SpringNetwork::cell_at_index(const Eigen::Vector3i& g) const {
+  const Eigen::Vector3i& n = block.cells;
+  if ((g.array() < 0).any() || (g.array() >= n.array()).any()) return -1;
+  return cell_at[static_cast<std::size_t>(g.x() + n.x() * (g.y() + n.y() * g.z()))];
+}
+
+SpringNetwork build_spring_network(const NetworkBlock& block, const std::vector<bool>& keep,
+                                   const CellStiffness& stiffness, double density, double damping_time) {
+  const Eigen::Vector3i& n = block.cells;
+  if ((n.array() < 1).any() || !(block.cell_size > 0.0))
+    throw std::invalid_argument("build_spring_network: the block needs >= 1 cell per axis and a cell size > 0");
+  const std::size_t total = static_cast<std::size_t>(n.x()) * n.y() * n.z();
+  if (keep.size() != total)
+    throw std::invalid_argument("build_spring_network: keep has " + std::to_string(keep.size()) + " entries, the block " +
+                                std::to_string(total) + " cells");
+  if (!(density > 0.0)) throw std::invalid_argument("build_spring_network: density must be > 0");
+  if (!(damping_time >= 0.0)) throw std::invalid_argument("build_spring_network: damping time must be >= 0");
+
+  SpringNetwork net;
+  net.block = block;
+  net.stiffness = stiffness;
+  const double h = block.cell_size;
+  net.cell_mass = density * h * h * h;
+  net.damping_time = damping_time;
+  net.cell_at.assign(total, -1);
+  const Eigen::Vector3i np = n + Eigen::Vector3i::Ones();
+  std::vector<int> node_of_point(static_cast<std::size_t>(np.x()) * np.y() * np.z(), -1);
+  std::vector<Eigen::Vector3d> positions;
+  for (int k = 0; k < n.z(); ++k)
+    for (int j = 0; j < n.y(); ++j)
+      for (int i = 0; i < n.x(); ++i) {
+        if (!keep[static_cast<std::size_t>(i + n.x() * (j + n.y() * k))]) continue;
+        std::array<int, 8> corners{};
+        for (int a = 0; a < 8; ++a) {
+          const Eigen::Vector3i p(i + (a & 1), j + ((a >> 1) & 1), k + ((a >> 2) & 1));
+          int& id = node_of_point[static_cast<std::size_t>(p.x() + np.x() * (p.y() + np.y() * p.z()))];
+          if (id < 0) {
+            id = static_cast<int>(positions.size());
+            positions.push_back(block.origin + h * p.cast<double>());
+          }
+          corners[static_cast<std::size_t>(a)] = id;
+        }
+        net.cell_at[static_cast<std::size_t>(i + n.x() * (j + n.y() * k))] = net.cell_count();
+        net.cell_index.emplace_back(i, j, k);
+        net.cell_nodes.push_back(corners);
+      }
+  if (net.cell_nodes.empty()) throw std::invalid_argument("build_spring_network: no cell is kept");
+  // Capacity: every corner of every cell its own node (a fully torn network).
+  const int capacity = 8 * net.cell_count();
+  net.node_count = static_cast<int>(positions.size());
+  net.rest.setZero(3, capacity);
+  for (int p = 0; p < net.node_count; ++p) net.rest.col(p) = positions[static_cast<std::size_t>(p)];
+  net.mass.assign(static_cast<std::size_t>(capacity), 0.0);
+  for (const auto& corners : net.cell_nodes)
+    for (int id : corners) net.mass[static_cast<std::size_t>(id)] += net.cell_mass / 8.0;
+  net.constraint.assign(static_cast<std::size_t>(capacity), 0);
+  return net;
+}
+
+Eigen::Matrix3d cell_deformation_gradient(const Eigen::Matrix<double, 3, 8>& corners, double h) {
+  // F = Σ_a x_a ⊗ g_a, g_a = s_a / (4h)
+  Eigen::Matrix3d F = Eigen::Matrix3d::Zero();
+  for (int a = 0; a < 8; ++a) F += corners.col(a) * (corner_sign(a) / (4.0 * h)).transpose();
+  return F;
+}
+
+double cell_forces(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
+                   const Eigen::Matrix<double, 3, 8>& v, Eigen::Matrix<double, 3, 8>& f) noexcept {
+  (void)cell;
+  f.setZero();
+  double energy = 0.0;
+  const double tau = net.damping_time;
+  const double L[4] = {0.0, net.rest_length(1), net.rest_length(2), net.rest_length(3)};
+  const double K[4] = {0.0, net.stiffness.edge, net.stiffness.face_diagonal, net.stiffness.body_diagonal};
+  for (const CellSpring& s : cell_springs) {
+    const Eigen::Vector3d e = x.col(s.b) - x.col(s.a);
+    const double l = e.norm();
+    if (!(l > 1e-12 * L[1])) continue; // coincident ends: no direction, no force
+    const Eigen::Vector3d d = e / l;
+    const double k = K[s.type];
+    const double stretch = l - L[s.type];
+    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d
+    const Eigen::Vector3d fa = (k * stretch + tau * k * (v.col(s.b) - v.col(s.a)).dot(d)) * d;
+    f.col(s.a) += fa;
+    f.col(s.b) -= fa;
+    energy += 0.5 * k * stretch * stretch;
+  }
+  const double kappa = net.stiffness.volume_modulus;
+  if (kappa > 0.0) {
+    const double h = net.block.cell_size;
+    const double V0 = h * h * h;
+    const Eigen::Matrix3d F = cell_deformation_gradient(x, h);
+    const double J = F.determinant();
+    const Eigen::Matrix3d cof = cofactor(F);
+    Eigen::Matrix<double, 3, 8> dJ; // ∂J/∂x_a = cof(F) g_a
+    double J_rate = 0.0;
+    for (int a = 0; a < 8; ++a) {
+      dJ.col(a) = cof * (corner_sign(a) / (4.0 * h));
+      J_rate += dJ.col(a).dot(v.col(a));
+    }
+    // f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a
+    f -= kappa * V0 * ((J - 1.0) + tau * J_rate) * dJ;
+    energy += 0.5 * kappa * V0 * (J - 1.0) * (J - 1.0);
+  }
+  return energy;
+}
+
+void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
+                           Eigen::Matrix<double, 24, 24>& K) noexcept {
+  (void)cell;
+  K.setZero();
+  for (const CellSpring& s : cell_springs) {
+    const Eigen::Vector3d e = x.col(s.b) - x.col(s.a);
+    const double l = e.norm();
+    const double L = net.rest_length(s.type);
+    const double k = net.spring_constant(s.type);
+    if (!(l > 1e-12 * L)) continue;
+    const Eigen::Vector3d d = e / l;
+    const Eigen::Matrix3d dd = d * d.transpose();
+    // K_aa = k [d dᵀ + max(0, 1 − L/l)(I − d dᵀ)]
+    const Eigen::Matrix3d Kaa = k * (dd + std::max(0.0, 1.0 - L / l) * (Eigen::Matrix3d::Identity() - dd));
+    K.block<3, 3>(3 * s.a, 3 * s.a) += Kaa;
+    K.block<3, 3>(3 * s.b, 3 * s.b) += Kaa;
+    K.block<3, 3>(3 * s.a, 3 * s.b) -= Kaa;
+    K.block<3, 3>(3 * s.b, 3 * s.a) -= Kaa;
+  }
+  const double kappa = net.stiffness.volume_modulus;
+  if (kappa > 0.0) {
+    const double h = net.block.cell_size;
+    const Eigen::Matrix3d cof = cofactor(cell_deformation_gradient(x, h));
+    Eigen::Matrix<double, 24, 1> dJ;
+    for (int a = 0; a < 8; ++a) dJ.segment<3>(3 * a) = cof * (corner_sign(a) / (4.0 * h));
+    // κ V₀ ∇J ∇Jᵀ
+    K.noalias() += kappa * h * h * h * dJ * dJ.transpose();
+  }
+}
+
+double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
+                      Eigen::Matrix3Xd& f) noexcept {
+  f.leftCols(net.node_count).setZero();
+  double energy = 0.0;
+  Eigen::Matrix<double, 3, 8> xc, vc, fc;
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(c)];
+    for (int a = 0; a < 8; ++a) {
+      xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
+      vc.col(a) = v.col(nodes[static_cast<std::size_t>(a)]);
+    }
+    energy += cell_forces(net, c, xc, vc, fc);
+    for (int a = 0; a < 8; ++a) f.col(nodes[static_cast<std::size_t>(a)]) += fc.col(a);
+  }
+  return energy;
+}
+
+} // namespace kerf

@@ -1,0 +1,88 @@
+#pragma once
+// SpringNetwork: paper 000 §2.1's coarse physical model — cubic cells joined at their vertices,
+// 28 springs per cell (every pair of its 8 nodes), built on a block of N_x x N_y x N_z cells of
+// which only the kept ones (those inside the body) exist. The springs of a cell belong to the
+// cell: splitting a vertex (tearing, §2.2) only re-points the corners of some cells to a copy.
+
+#include "realtime/springs/cell_stiffness.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace kerf {
+
+/// The block of cells the network is cut from: cell (i, j, k) spans origin + h [i, i+1] x [j,
+/// j+1] x [k, k+1] [m].
+struct NetworkBlock {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero(); ///< lower corner [m]
+  double cell_size = 0.0;                           ///< h [m] > 0
+  Eigen::Vector3i cells = Eigen::Vector3i::Ones();  ///< cells along x, y, z (each >= 1)
+};
+
+/// The 28 springs of a cell as pairs of local corners. Local corner a = bx + 2 by + 4 bz sits at
+/// origin + h (i + bx, j + by, k + bz); `type` is 1 (edge), 2 (face diagonal), 3 (body diagonal),
+/// the number of axes along which the two corners differ.
+struct CellSpring {
+  int a, b, type;
+};
+extern const std::array<CellSpring, 28> cell_springs;
+
+/// Node constraint bits: a fixed axis keeps the position the caller gives it (supports, tools).
+enum NodeConstraint : std::uint8_t { fix_x = 1, fix_y = 2, fix_z = 4, fix_all = 7 };
+
+/// The network (paper 000 §2.1). Node arrays are sized for `node_capacity()` so that tearing
+/// can add copies of split vertices without allocating; nodes [0, node_count) are in use.
+struct SpringNetwork {
+  NetworkBlock block;
+  CellStiffness stiffness;
+  double cell_mass = 0.0;     ///< ρ h³ [kg], lumped 1/8 on each corner
+  double damping_time = 0.0;  ///< Kelvin–Voigt retardation time τ = η/E [s]: dashpot c = τ k per spring
+  std::vector<Eigen::Vector3i> cell_index;     ///< grid index of each cell
+  std::vector<std::array<int, 8>> cell_nodes;  ///< node of each local corner
+  std::vector<int> cell_at;                    ///< block cell (i + Nx (j + Ny k)) -> cell, or -1
+  Eigen::Matrix3Xd rest;                       ///< 3 x capacity rest positions [m]
+  std::vector<double> mass;                    ///< [kg]
+  std::vector<std::uint8_t> constraint;        ///< NodeConstraint bits
+  int node_count = 0;
+
+  [[nodiscard]] int cell_count() const { return static_cast<int>(cell_nodes.size()); }
+  [[nodiscard]] int node_capacity() const { return static_cast<int>(rest.cols()); }
+  [[nodiscard]] double rest_length(int type) const;
+  [[nodiscard]] double spring_constant(int type) const;
+  /// The kept cell at grid index g, or -1 (outside the block or pruned).
+  [[nodiscard]] int cell_at_index(const Eigen::Vector3i& g) const;
+};
+
+/// Builds the network of the cells of `block` marked in `keep` (size Nx Ny Nz, index i + Nx (j +
+/// Ny k)): shared vertices become one node, masses lumped (ρ h³ / 8 per cell corner), stiffness
+/// as given, τ = η / E. Throws std::invalid_argument on bad sizes, no kept cell, or ρ <= 0.
+SpringNetwork build_spring_network(const NetworkBlock& block, const std::vector<bool>& keep,
+                                   const CellStiffness& stiffness, double density, double damping_time);
+
+/// The deformation gradient of a cell at its centre from its corners x_a (trilinear shape
+/// functions): F = Σ_a x_a ⊗ g_a, g_a = s_a / (4h) with s_a the corner's sign vector (±1)³.
+Eigen::Matrix3d cell_deformation_gradient(const Eigen::Matrix<double, 3, 8>& corners, double cell_size);
+
+/// Internal forces of one cell on its 8 corners [N] at positions `x` and velocities `v`:
+///   spring:  f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = (x_b − x_a)/l   (and −that on b);
+///   volume:  f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a,  J = det F,  J̇ = Σ_b (cof(F) g_b)·v_b.
+/// Returns the cell's elastic energy Σ ½ k (l − L)² + ½ κ V₀ (J − 1)² [J].
+double cell_forces(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
+                   const Eigen::Matrix<double, 3, 8>& v, Eigen::Matrix<double, 3, 8>& f) noexcept;
+
+/// The cell's stiffness (24 x 24, corner-major) for Newton, kept positive semi-definite:
+///   spring block K_aa = k [d dᵀ + max(0, 1 − L/l)(I − d dᵀ)], K_ab = −K_aa;
+///   volume block κ V₀ (cof(F) g_a)(cof(F) g_b)ᵀ (the (J − 1) ∂²J term is left out).
+/// At rest it is the exact linear stiffness.
+void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
+                           Eigen::Matrix<double, 24, 24>& K) noexcept;
+
+/// Sum of all cells' internal forces into f (3 x capacity, overwritten for nodes in use);
+/// returns the elastic energy [J]. Allocation-free.
+double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
+                      Eigen::Matrix3Xd& f) noexcept;
+
+} // namespace kerf

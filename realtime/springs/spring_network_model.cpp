@@ -1,0 +1,314 @@
+#include "realtime/springs/spring_network_model.hpp"
+
+#include "meshes/surface_mesh.hpp"
+#include "realtime/springs/symplectic_euler.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace kerf {
+
+std::string_view to_string(SpringIntegrator integrator) {
+  switch (integrator) {
+  case SpringIntegrator::symplectic_euler: return "explicit";
+  case SpringIntegrator::implicit_euler: return "implicit";
+  case SpringIntegrator::quasi_static: return "static";
+  }
+  return "explicit";
+}
+
+std::optional<SpringIntegrator> spring_integrator_from_string(std::string_view name) {
+  if (name == "explicit") return SpringIntegrator::symplectic_euler;
+  if (name == "implicit") return SpringIntegrator::implicit_euler;
+  if (name == "static") return SpringIntegrator::quasi_static;
+  return std::nullopt;
+}
+
+namespace {
+
+/// Safety factor on the computed explicit limit (the limit is for the linearised network).
+constexpr double explicit_safety = 0.9;
+/// Sub-steps beyond this in one sample are reported as over budget.
+constexpr int max_substeps = 100000;
+
+/// Nodes of `net` within `tolerance` of a triangle of `group`: distance to the triangle's plane
+/// within tolerance and the projection inside the triangle's box grown by the tolerance.
+std::vector<bool> nodes_on_surface(const SpringNetwork& net, const TetMesh& mesh, const SurfaceGroup& group,
+                                   double tolerance) {
+  std::vector<bool> on(static_cast<std::size_t>(net.node_count), false);
+  for (int t = 0; t < group.triangles.rows(); ++t) {
+    const Eigen::Vector3d a = mesh.nodes.row(group.triangles(t, 0)).transpose();
+    const Eigen::Vector3d b = mesh.nodes.row(group.triangles(t, 1)).transpose();
+    const Eigen::Vector3d c = mesh.nodes.row(group.triangles(t, 2)).transpose();
+    const Eigen::Vector3d n = (b - a).cross(c - a).normalized();
+    const Eigen::Vector3d lo = a.cwiseMin(b).cwiseMin(c).array() - tolerance;
+    const Eigen::Vector3d hi = a.cwiseMax(b).cwiseMax(c).array() + tolerance;
+    for (int p = 0; p < net.node_count; ++p) {
+      const Eigen::Vector3d q = net.rest.col(p);
+      if (std::abs((q - a).dot(n)) <= tolerance && (q.array() >= lo.array()).all() && (q.array() <= hi.array()).all())
+        on[static_cast<std::size_t>(p)] = true;
+    }
+  }
+  return on;
+}
+
+/// Point-in-body against the tetrahedra themselves, bucketed on the block's grid grown by one
+/// cell on each side (the only region the construction asks about).
+class BodyContainment {
+public:
+  BodyContainment(const TetMesh& mesh, const NetworkBlock& block) : m_mesh(mesh), m_block(block) {
+    m_dims = block.cells + Eigen::Vector3i::Constant(2);
+    m_buckets.resize(static_cast<std::size_t>(m_dims.prod()));
+    for (int t = 0; t < mesh.tets.rows(); ++t) {
+      Eigen::Vector3d lo = mesh.nodes.row(mesh.tets(t, 0)).transpose(), hi = lo;
+      for (int k = 1; k < 4; ++k) {
+        lo = lo.cwiseMin(mesh.nodes.row(mesh.tets(t, k)).transpose());
+        hi = hi.cwiseMax(mesh.nodes.row(mesh.tets(t, k)).transpose());
+      }
+      const Eigen::Vector3i a = bucket(lo), b = bucket(hi);
+      if ((b.array() < 0).any() || (a.array() >= m_dims.array()).any()) continue;
+      const Eigen::Vector3i a0 = a.cwiseMax(0), b0 = b.cwiseMin(m_dims - Eigen::Vector3i::Ones());
+      for (int k = a0.z(); k <= b0.z(); ++k)
+        for (int j = a0.y(); j <= b0.y(); ++j)
+          for (int i = a0.x(); i <= b0.x(); ++i) m_buckets[static_cast<std::size_t>(i + m_dims.x() * (j + m_dims.y() * k))].push_back(t);
+    }
+  }
+  /// True if p lies in a tetrahedron (barycentric coordinates >= −1e-12).
+  bool contains(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3i g = bucket(p);
+    if ((g.array() < 0).any() || (g.array() >= m_dims.array()).any()) return false;
+    for (int t : m_buckets[static_cast<std::size_t>(g.x() + m_dims.x() * (g.y() + m_dims.y() * g.z()))]) {
+      const Eigen::Vector3d a = m_mesh.nodes.row(m_mesh.tets(t, 0)).transpose();
+      Eigen::Matrix3d T;
+      for (int k = 0; k < 3; ++k) T.col(k) = m_mesh.nodes.row(m_mesh.tets(t, k + 1)).transpose() - a;
+      const Eigen::Vector3d l = T.lu().solve(p - a);
+      if (l.minCoeff() >= -1e-12 && l.sum() <= 1.0 + 1e-12) return true;
+    }
+    return false;
+  }
+
+private:
+  Eigen::Vector3i bucket(const Eigen::Vector3d& p) const {
+    return ((p - m_block.origin) / m_block.cell_size).array().floor().cast<int>() + 1;
+  }
+  const TetMesh& m_mesh;
+  NetworkBlock m_block;
+  Eigen::Vector3i m_dims;
+  std::vector<std::vector<int>> m_buckets;
+};
+
+/// The coordinate axis a sliding support's triangles are normal to; throws if they are not.
+int support_axis(const TetMesh& mesh, const SurfaceGroup& group) {
+  Eigen::Vector3d weight = Eigen::Vector3d::Zero();
+  for (int t = 0; t < group.triangles.rows(); ++t) {
+    const Eigen::Vector3d a = mesh.nodes.row(group.triangles(t, 0)).transpose();
+    const Eigen::Vector3d b = mesh.nodes.row(group.triangles(t, 1)).transpose();
+    const Eigen::Vector3d c = mesh.nodes.row(group.triangles(t, 2)).transpose();
+    const Eigen::Vector3d n = (b - a).cross(c - a);
+    weight += n.cwiseAbs();
+  }
+  int axis = 0;
+  weight.maxCoeff(&axis);
+  if (weight[axis] < 0.999 * weight.sum())
+    throw std::invalid_argument("springs: sliding support \"" + group.name +
+                                "\" is not normal to a coordinate axis (only axis-aligned sliding supports are represented)");
+  return axis;
+}
+
+} // namespace
+
+SpringNetworkModel::SpringNetworkModel(const TetMesh& mesh, SpringNetworkSetup setup) : m_setup(std::move(setup)) {
+  const SpringNetworkSetup& s = m_setup;
+  if (s.styluses.empty() || s.styluses.size() > 2)
+    throw std::invalid_argument("springs: needs one or two styluses, got " + std::to_string(s.styluses.size()));
+  if (s.cells < 1) throw std::invalid_argument("springs: cells per block side must be >= 1, got " + std::to_string(s.cells));
+  if (!(s.cell_size >= 0.0)) throw std::invalid_argument("springs: cell size must be >= 0 (0: automatic)");
+  if (!(s.damping >= 0.0)) throw std::invalid_argument("springs: damping must be >= 0 Pa s");
+  if (s.tearing && !(s.tensile_limit > 0.0)) throw std::invalid_argument("springs: tearing needs a tensile limit > 0 Pa");
+  if (mesh.tets.rows() == 0) throw std::invalid_argument("springs: the mesh has no tetrahedra");
+  build(mesh);
+  reset();
+}
+
+void SpringNetworkModel::build(const TetMesh& mesh) {
+  const SpringNetworkSetup& s = m_setup;
+  const SurfaceQuery body(boundary_surface(mesh));
+  const Eigen::Vector3d box_lo = mesh.nodes.colwise().minCoeff().transpose();
+  const Eigen::Vector3d box_hi = mesh.nodes.colwise().maxCoeff().transpose();
+  const Eigen::Vector3d extent = box_hi - box_lo;
+
+  // 1. The block around the contact points.
+  std::vector<Eigen::Vector3d> contact;
+  for (const SpringStylus& t : s.styluses) contact.push_back(body.closest_point(t.start).point);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  for (const auto& c : contact) centre += c / static_cast<double>(contact.size());
+  double spread = 0.0;
+  for (const auto& a : contact)
+    for (const auto& b : contact) spread = std::max(spread, (a - b).norm());
+  const double h = s.cell_size > 0.0 ? s.cell_size : std::max(extent.minCoeff(), 2.0 * spread) / s.cells;
+  const double side = h * s.cells;
+  NetworkBlock block;
+  block.cell_size = h;
+  block.cells = Eigen::Vector3i::Constant(s.cells);
+  for (int i = 0; i < 3; ++i)
+    block.origin[i] = side >= extent[i] ? box_lo[i] : std::clamp(centre[i] - 0.5 * side, box_lo[i], box_hi[i] - side);
+
+  // 2. Pruning: keep the cells mostly inside the body (point-in-tetrahedron on the mesh).
+  const BodyContainment inside_body(mesh, block);
+  std::vector<bool> keep(static_cast<std::size_t>(block.cells.prod()), false);
+  for (int k = 0; k < s.cells; ++k)
+    for (int j = 0; j < s.cells; ++j)
+      for (int i = 0; i < s.cells; ++i) {
+        const Eigen::Vector3d lo = block.origin + h * Eigen::Vector3d(i, j, k);
+        int inside = inside_body.contains(lo + Eigen::Vector3d::Constant(0.5 * h)) ? 1 : 0;
+        for (int a = 0; a < 8; ++a)
+          inside += inside_body.contains(lo + h * Eigen::Vector3d(0.25 + 0.5 * (a & 1), 0.25 + 0.5 * ((a >> 1) & 1), 0.25 + 0.5 * ((a >> 2) & 1))) ? 1 : 0;
+        keep[static_cast<std::size_t>(i + s.cells * (j + s.cells * k))] = inside >= 5;
+      }
+
+  const bool volume = s.volume_term && s.poisson_ratio >= 0.25;
+  m_identification = identify_cell_stiffness(s.youngs_modulus, s.poisson_ratio, h, volume);
+  if (!(s.density > 0.0)) throw std::invalid_argument("springs: density must be > 0 kg/m^3");
+  SpringNetwork net = build_spring_network(block, keep, m_identification.stiffness, s.density, s.damping / s.youngs_modulus);
+
+  // 3. Supports, and the block's faces inside the body.
+  for (const SpringSupport& support : s.supports) {
+    const SurfaceGroup* group = mesh.find_surface_group(support.surface);
+    if (!group) throw std::invalid_argument("springs: support surface \"" + support.surface + "\" is not in the mesh");
+    const std::uint8_t bits = support.sliding ? static_cast<std::uint8_t>(1u << support_axis(mesh, *group)) : static_cast<std::uint8_t>(fix_all);
+    const std::vector<bool> on = nodes_on_surface(net, mesh, *group, 0.25 * h);
+    for (int p = 0; p < net.node_count; ++p)
+      if (on[static_cast<std::size_t>(p)]) net.constraint[static_cast<std::size_t>(p)] |= bits;
+  }
+  for (int p = 0; p < net.node_count; ++p) {
+    const Eigen::Vector3d grid = (net.rest.col(p) - block.origin) / h;
+    for (int i = 0; i < 3; ++i) {
+      const double sign = std::abs(grid[i]) < 1e-9 ? -1.0 : std::abs(grid[i] - s.cells) < 1e-9 ? 1.0 : 0.0;
+      if (sign != 0.0 && inside_body.contains(net.rest.col(p) + 0.5 * h * sign * Eigen::Vector3d::Unit(i)))
+        net.constraint[static_cast<std::size_t>(p)] = fix_all;
+    }
+  }
+
+  // 4. Nodes under each stylus tip are attached to it.
+  m_attached_to.assign(static_cast<std::size_t>(net.node_capacity()), -1);
+  for (int t = 0; t < static_cast<int>(s.styluses.size()); ++t) {
+    const SpringStylus& stylus = s.styluses[static_cast<std::size_t>(t)];
+    int nearest = -1;
+    double nearest_distance = INFINITY;
+    int count = 0;
+    for (int p = 0; p < net.node_count; ++p) {
+      if (m_attached_to[static_cast<std::size_t>(p)] >= 0) continue;
+      const double d = (net.rest.col(p) - stylus.start).norm();
+      if (d < nearest_distance) nearest_distance = d, nearest = p;
+      if (d <= stylus.radius + 0.5 * h) {
+        m_attached_to[static_cast<std::size_t>(p)] = t;
+        ++count;
+      }
+    }
+    if (count == 0 && nearest >= 0) m_attached_to[static_cast<std::size_t>(nearest)] = t;
+  }
+  for (int p = 0; p < net.node_count; ++p)
+    if (m_attached_to[static_cast<std::size_t>(p)] >= 0) net.constraint[static_cast<std::size_t>(p)] = fix_all;
+  m_excluded.assign(static_cast<std::size_t>(net.node_capacity()), 0);
+  for (int p = 0; p < net.node_count; ++p) m_excluded[static_cast<std::size_t>(p)] = m_attached_to[static_cast<std::size_t>(p)] >= 0;
+
+  m_initial = std::move(net);
+  m_omega_max = highest_angular_frequency(m_initial);
+  m_stability_limit = symplectic_euler_stability_limit(m_omega_max, m_initial.damping_time);
+}
+
+int SpringNetworkModel::attached_nodes(int stylus) const {
+  return static_cast<int>(std::count(m_attached_to.begin(), m_attached_to.end(), stylus));
+}
+
+void SpringNetworkModel::reset() {
+  m_net = m_initial;
+  const int cap = m_net.node_capacity();
+  m_x = m_net.rest;
+  m_v.setZero(3, cap);
+  m_f.setZero(3, cap);
+  m_zero.setZero(3, cap);
+  m_last_tool.assign(m_setup.styluses.size(), Eigen::Vector3d::Zero());
+  m_started = false;
+  m_tears = 0;
+  m_last_substeps = 0;
+  m_piece_parent.assign(static_cast<std::size_t>(cap), 0);
+  m_piece_label.assign(static_cast<std::size_t>(m_net.cell_count()), 0);
+  m_pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
+  m_newton.reset();
+  if (m_setup.integrator == SpringIntegrator::implicit_euler)
+    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::implicit_euler, 8);
+  else if (m_setup.integrator == SpringIntegrator::quasi_static)
+    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::quasi_static, 30);
+  m_tearing = m_setup.tearing ? std::make_unique<VertexTearing>(m_net, m_setup.tensile_limit) : nullptr;
+}
+
+void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::span<ForceSample> forces) noexcept {
+  const int n_tools = tool_count();
+  if (static_cast<int>(tools.size()) != n_tools || forces.size() != tools.size() || !(dt > 0.0)) {
+    for (ForceSample& f : forces) f = ForceSample{Eigen::Vector3d::Zero(), InteractionMode::no_contact, 0.0, true};
+    return;
+  }
+  if (!m_started) {
+    for (int t = 0; t < n_tools; ++t) m_last_tool[static_cast<std::size_t>(t)] = tools[static_cast<std::size_t>(t)].position;
+    m_started = true;
+  }
+  // Attached node target: rest + (tool position − stylus start), at fraction s of the sample.
+  const auto place_attached = [&](double s) {
+    for (int p = 0; p < m_net.node_count; ++p) {
+      const int t = m_attached_to[static_cast<std::size_t>(p)];
+      if (t < 0) continue;
+      const Eigen::Vector3d& from = m_last_tool[static_cast<std::size_t>(t)];
+      const Eigen::Vector3d& to = tools[static_cast<std::size_t>(t)].position;
+      const Eigen::Vector3d target = m_net.rest.col(p) + (from + s * (to - from)) - m_setup.styluses[static_cast<std::size_t>(t)].start;
+      m_v.col(p) = (to - from) / dt;
+      m_x.col(p) = target;
+    }
+  };
+  bool over_budget = false;
+  if (m_setup.integrator == SpringIntegrator::symplectic_euler) {
+    const double ratio = dt / (explicit_safety * m_stability_limit);
+    int substeps = std::isfinite(ratio) ? static_cast<int>(std::ceil(ratio)) : 1;
+    if (substeps > max_substeps) substeps = max_substeps, over_budget = true;
+    substeps = std::max(substeps, 1);
+    const double h = dt / substeps;
+    for (int k = 1; k <= substeps; ++k) {
+      place_attached(static_cast<double>(k) / substeps);
+      symplectic_euler_step(m_net, m_x, m_v, h, m_f);
+    }
+    m_last_substeps = substeps;
+  } else {
+    place_attached(1.0);
+    const NewtonReport report = m_newton->advance(m_net, m_x, m_v, dt);
+    over_budget = !report.converged;
+    m_last_substeps = report.iterations;
+  }
+  for (int t = 0; t < n_tools; ++t) m_last_tool[static_cast<std::size_t>(t)] = tools[static_cast<std::size_t>(t)].position;
+
+  // The force on each stylus: the sum of the internal forces on its attached nodes.
+  network_forces(m_net, m_x, m_setup.integrator == SpringIntegrator::quasi_static ? m_zero : m_v, m_f);
+  bool finite = m_x.leftCols(m_net.node_count).allFinite();
+  for (int t = 0; t < n_tools; ++t) forces[static_cast<std::size_t>(t)] = ForceSample{Eigen::Vector3d::Zero(), InteractionMode::deformation_1, 0.0, over_budget};
+  for (int p = 0; p < m_net.node_count; ++p)
+    if (const int t = m_attached_to[static_cast<std::size_t>(p)]; t >= 0) forces[static_cast<std::size_t>(t)].force += m_f.col(p);
+
+  if (m_tearing && finite && m_tearing->tear(m_net, m_x, m_v, m_excluded)) {
+    ++m_tears;
+    if (m_newton) m_newton->rebuild(m_net);
+    const int pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
+    if (pieces > m_pieces)
+      for (ForceSample& f : forces) f.mode = InteractionMode::rupture;
+    m_pieces = pieces;
+  }
+  for (ForceSample& f : forces)
+    if (!finite || !f.force.allFinite()) {
+      f.force.setZero();
+      f.over_budget = true;
+    }
+}
+
+} // namespace kerf

@@ -1,0 +1,119 @@
+#pragma once
+// SpringNetworkModel: paper 000 §2 as a ToolModel — a coarse cubic spring network built around
+// the styluses, pruned to the body, fixed where the body is supported, with the nodes under each
+// stylus tip attached to it; stepped by a selectable integrator; torn past the tensile limit.
+
+#include "meshes/tet_mesh.hpp"
+#include "realtime/springs/newton_stepper.hpp"
+#include "realtime/springs/spring_network.hpp"
+#include "realtime/springs/vertex_tearing.hpp"
+#include "realtime/tool_model.hpp"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace kerf {
+
+/// How the network is advanced per sample.
+enum class SpringIntegrator {
+  symplectic_euler, ///< explicit, sub-stepped under the computed stability limit
+  implicit_euler,   ///< backward Euler by Newton with a kept sparse LDLᵀ factorisation
+  quasi_static      ///< static equilibrium per sample (for comparison with the reference)
+};
+/// "explicit", "implicit", "static".
+std::string_view to_string(SpringIntegrator integrator);
+std::optional<SpringIntegrator> spring_integrator_from_string(std::string_view name);
+
+/// A supported surface of the body (a physical surface of the mesh): bonded fixes the network
+/// nodes on it, sliding fixes only the axis of its normal (which must be a coordinate axis).
+struct SpringSupport {
+  std::string surface;
+  bool sliding = false;
+};
+
+/// A stylus: its tip centre at the first sample [m] and tip radius [m].
+struct SpringStylus {
+  Eigen::Vector3d start = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+};
+
+/// Everything the model is built from (SI units).
+struct SpringNetworkSetup {
+  double youngs_modulus = 0.0;  ///< E [Pa]
+  double poisson_ratio = 0.0;   ///< ν
+  double density = 0.0;         ///< ρ [kg/m^3]
+  double damping = 0.0;         ///< Kelvin–Voigt viscosity η [Pa s]
+  bool volume_term = true;      ///< per-cell volume term (represents ν >= 1/4; off below)
+  int cells = 8;                ///< N: cells per side of the block (>= 1)
+  double cell_size = 0.0;       ///< h [m]; 0: the block side over N (see the constructor)
+  SpringIntegrator integrator = SpringIntegrator::symplectic_euler;
+  bool tearing = false;
+  double tensile_limit = 0.0;   ///< σ_max [Pa] > 0 when tearing
+  std::vector<SpringSupport> supports;
+  std::vector<SpringStylus> styluses; ///< one or two
+};
+
+/// The model. Construction (allocates):
+/// 1. block: the styluses' contact points (closest body-surface points to the tip centres) give
+///    its centre c; its side S = N h, with h given or h = max(smallest body extent, 2 x the
+///    styluses' spread) / N; per axis it is placed at c − S/2 shifted into the body's bounding box
+///    (or at the box's lower side when S exceeds the box).
+/// 2. pruning: a cell is kept when at least 5 of 9 sample points (its centre and the 8 points at
+///    quarter positions) lie inside the body (SurfaceQuery::contains on the mesh's boundary).
+/// 3. supports: nodes within h/4 of a support surface are fixed (bonded) or fixed along its normal
+///    (sliding); nodes on the block's outer faces where the body continues outside the block are
+///    fixed (the material beyond the network is taken as rigid).
+/// 4. styluses: nodes within r + h/2 of a tip centre (at least the nearest one) are attached to it
+///    and move with it (paper 000 §2.1: "the vertices at the stylus tip is fixed to the stylus").
+/// `step`: attached nodes follow the stylus; the network is advanced by dt with the integrator;
+/// the force on each stylus is the sum of the internal forces on its attached nodes; mode is
+/// deformation-1, and rupture on the sample in which a tear separates the network into more
+/// pieces. A tear under the implicit or quasi-static integrator re-analyses the sparse pattern
+/// (the one allocation `step` may make, once per tear); the explicit integrator tears without.
+class SpringNetworkModel : public ToolModel {
+public:
+  SpringNetworkModel(const TetMesh& mesh, SpringNetworkSetup setup);
+
+  [[nodiscard]] std::string_view name() const override { return "springs"; }
+  [[nodiscard]] int tool_count() const override { return static_cast<int>(m_setup.styluses.size()); }
+  void reset() override;
+  void step(std::span<const ToolState> tools, double dt, std::span<ForceSample> forces) noexcept override;
+
+  /// The network as it is now (cells re-pointed by tears) and its node positions [m].
+  [[nodiscard]] const SpringNetwork& network() const { return m_net; }
+  [[nodiscard]] const Eigen::Matrix3Xd& positions() const { return m_x; }
+  /// What the constructor identified and computed.
+  [[nodiscard]] const CellIdentification& identification() const { return m_identification; }
+  [[nodiscard]] double stability_limit() const { return m_stability_limit; } ///< explicit h_crit [s]
+  [[nodiscard]] int last_substeps() const { return m_last_substeps; }
+  [[nodiscard]] int tears() const { return m_tears; }     ///< vertex splits so far
+  [[nodiscard]] int pieces() const { return m_pieces; }   ///< connected pieces of the network
+  [[nodiscard]] int attached_nodes(int stylus) const;
+
+private:
+  void build(const TetMesh& mesh);
+
+  SpringNetworkSetup m_setup;
+  CellIdentification m_identification;
+  SpringNetwork m_initial, m_net;
+  std::vector<int> m_attached_to;        ///< per node: stylus index or -1
+  std::vector<std::uint8_t> m_excluded;  ///< per node: not torn (attached)
+  Eigen::Matrix3Xd m_x, m_v, m_f, m_zero;
+  std::vector<Eigen::Vector3d> m_last_tool;
+  bool m_started = false;
+  double m_omega_max = 0.0;
+  double m_stability_limit = 0.0;
+  int m_last_substeps = 0;
+  int m_tears = 0;
+  int m_pieces = 1;
+  std::unique_ptr<NewtonStepper> m_newton;
+  std::unique_ptr<VertexTearing> m_tearing;
+  std::vector<int> m_piece_parent, m_piece_label;
+};
+
+} // namespace kerf

@@ -1,0 +1,27 @@
+#pragma once
+// Symplectic (semi-implicit) Euler for the spring network, with the stability limit it computes
+// from the network itself.
+
+#include "realtime/springs/spring_network.hpp"
+
+namespace kerf {
+
+/// Highest angular frequency ω_max [rad/s] of the network linearised at rest over its free
+/// degrees of freedom: the largest eigenvalue of M^(-1/2) K₀ M^(-1/2), by power iteration with a
+/// Rayleigh quotient (a lower bound that converges to ω_max²). Allocates (construction time).
+double highest_angular_frequency(const SpringNetwork& net);
+
+/// The stability limit of symplectic Euler on a mode of frequency ω with stiffness-proportional
+/// damping ζ = τ ω / 2 (the Kelvin–Voigt dashpots c = τ k): the amplification matrix of
+/// v⁺ = v + h(−ω² x − 2ζω v), x⁺ = x + h v⁺ has |eigenvalues| <= 1 iff (Jury's criterion)
+///   h <= (2 / ω) (√(1 + ζ²) − ζ),
+/// which is 2/ω undamped [s].
+double symplectic_euler_stability_limit(double omega_max, double damping_time);
+
+/// One step of length h [s]: v ← v + h M⁻¹ f(x, v), then x ← x + h v, on the free axes of the
+/// nodes in use; fixed axes keep the x and v the caller set. `f` is workspace (3 x capacity).
+/// Returns the elastic energy at the start of the step [J]. Allocation-free.
+double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
+                             Eigen::Matrix3Xd& f) noexcept;
+
+} // namespace kerf

@@ -1,0 +1,49 @@
+#pragma once
+// Tearing of the spring network, paper 000 §2.2: the approximate maximum tensile stress at each
+// vertex shared by cells; past the material's limit the vertex is split and the cells sharing it
+// are regrouped by the sign of their contribution along the tension (the crack perpendicular to
+// the tension).
+
+#include "realtime/springs/spring_network.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace kerf {
+
+/// The virial (Cauchy) stress of one cell [Pa], tension positive:
+///   σ = (1/V₀) Σ_springs k (l − L) l d ⊗ d  +  κ (J − 1) I,  V₀ = h³.
+Eigen::Matrix3d cell_stress(const SpringNetwork& net, const Eigen::Matrix<double, 3, 8>& x) noexcept;
+
+/// Connected pieces of the network: cells sharing a node are connected. Writes each cell's
+/// piece label (a node id shared by all cells of the piece) into `label` (size cell_count())
+/// and returns the number of pieces. `parent` is
+/// workspace of size >= node_capacity(). Allocation-free when the vectors are sized.
+int network_pieces(const SpringNetwork& net, std::vector<int>& parent, std::vector<int>& label) noexcept;
+
+/// Paper 000 §2.2 on a network: holds the per-node workspace so that `tear` allocates nothing.
+class VertexTearing {
+public:
+  /// `tensile_limit` σ_max [Pa] > 0 (the scene's cohesive strength).
+  VertexTearing(const SpringNetwork& net, double tensile_limit);
+
+  /// Finds the vertex (shared by >= 2 cells, not `excluded`) whose averaged cell stress has the
+  /// largest principal value σ₁ > σ_max, and splits it: the cells whose own force on the vertex
+  /// points along +n₁ (the tension direction) keep it, the others get a copy of it (position,
+  /// velocity, rest position and constraint copied; mass re-lumped). At most one split per call.
+  /// Returns true if a vertex was split. `excluded` has one entry per node (capacity).
+  bool tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, const std::vector<std::uint8_t>& excluded) noexcept;
+
+  /// Largest principal vertex stress found by the last `tear` [Pa].
+  [[nodiscard]] double last_max_stress() const { return m_last_max; }
+
+private:
+  double m_limit;
+  double m_last_max = 0.0;
+  std::vector<Eigen::Matrix3d> m_stress; ///< per node, summed over its cells
+  std::vector<int> m_cells;              ///< per node, number of cells
+};
+
+} // namespace kerf

@@ -1,0 +1,143 @@
+// The realtime contract (../shared/DESIGN.md): `step` allocates nothing. This program replaces
+// the global operator new/delete and (outside sanitizer builds) glibc's malloc family with
+// counting versions (the technique of tests/realtime/fracture/test_no_allocation.cpp), then
+// steps the spring-network model with each integrator through a pull and hold on clay_pull, and
+// the explicit one through a two-stylus pull that tears the network.
+
+#include "tests/realtime/springs/model_fixtures.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+
+namespace {
+std::atomic<long> allocations{0};
+thread_local bool counting = false;
+void note_allocation() {
+  if (counting) allocations.fetch_add(1, std::memory_order_relaxed);
+}
+} // namespace
+
+// These replacements pair operator new with std::free through malloc, which is correct, but GCC
+// sees free() on a pointer from operator new once delete is inlined and warns.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+
+void* operator new(std::size_t size) {
+  note_allocation();
+  if (void* p = std::malloc(size ? size : 1)) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size) { return operator new(size); }
+void* operator new(std::size_t size, std::align_val_t align) {
+  note_allocation();
+  if (void* p = std::aligned_alloc(static_cast<std::size_t>(align), (size + static_cast<std::size_t>(align) - 1) / static_cast<std::size_t>(align) * static_cast<std::size_t>(align))) return p;
+  throw std::bad_alloc();
+}
+void* operator new[](std::size_t size, std::align_val_t align) { return operator new(size, align); }
+// The nothrow forms too: every allocation function is replaced, so every delete may free().
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+  note_allocation();
+  return std::malloc(size ? size : 1);
+}
+void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept { return operator new(size, tag); }
+void* operator new(std::size_t size, std::align_val_t align, const std::nothrow_t&) noexcept {
+  note_allocation();
+  const auto a = static_cast<std::size_t>(align);
+  return std::aligned_alloc(a, (size + a - 1) / a * a);
+}
+void* operator new[](std::size_t size, std::align_val_t align, const std::nothrow_t& tag) noexcept {
+  return operator new(size, align, tag);
+}
+void operator delete(void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t, const std::nothrow_t&) noexcept { std::free(p); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+void operator delete(void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
+
+#if !defined(__SANITIZE_ADDRESS__) && defined(__GLIBC__)
+// Eigen and C code allocate with malloc directly: count those too, through glibc's own entry
+// points (sanitizer builds intercept malloc themselves, so there only operator new is counted).
+extern "C" {
+void* __libc_malloc(std::size_t);
+void* __libc_calloc(std::size_t, std::size_t);
+void* __libc_realloc(void*, std::size_t);
+void* malloc(std::size_t size) {
+  note_allocation();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t n, std::size_t size) {
+  note_allocation();
+  return __libc_calloc(n, size);
+}
+void* realloc(void* p, std::size_t size) {
+  note_allocation();
+  return __libc_realloc(p, size);
+}
+}
+#endif
+
+using namespace kerf;
+
+namespace {
+/// Steps `model` along `path(k)` (one position per stylus) for `samples` samples, counting.
+template <class Path>
+long allocations_while_stepping(SpringNetworkModel& model, int samples, Path path) {
+  std::vector<ToolState> tools(static_cast<std::size_t>(model.tool_count()));
+  std::vector<ForceSample> forces(tools.size());
+  model.step(tools = path(0), 1e-3, forces); // first sample outside the count
+  allocations = 0;
+  counting = true;
+  for (int k = 1; k <= samples; ++k) {
+    const std::vector<ToolState>& next = path(k);
+    for (std::size_t t = 0; t < tools.size(); ++t) tools[t] = next[t];
+    model.step(tools, 1e-3, forces);
+  }
+  counting = false;
+  return allocations.load();
+}
+} // namespace
+
+TEST(RealtimeContract, SpringNetworkStepAllocatesNothing) {
+  counting = true;
+  ::operator delete(::operator new(16));
+  counting = false;
+  ASSERT_GE(allocations.load(), 1);
+
+  const TetMesh mesh = test::clay_pull_mesh();
+  for (const SpringIntegrator integrator :
+       {SpringIntegrator::symplectic_euler, SpringIntegrator::implicit_euler, SpringIntegrator::quasi_static}) {
+    SpringNetworkModel model(mesh, test::clay_pull_setup(integrator));
+    std::vector<std::vector<ToolState>> path(301, std::vector<ToolState>(1));
+    for (int k = 0; k <= 300; ++k) path[static_cast<std::size_t>(k)][0].position = {0.02, 0.0, 0.022 + 5e-6 * std::min(k, 200)};
+    EXPECT_EQ(allocations_while_stepping(model, 300, [&](int k) -> const std::vector<ToolState>& { return path[static_cast<std::size_t>(k)]; }), 0)
+        << to_string(integrator);
+  }
+}
+
+TEST(RealtimeContract, ExplicitTearingAllocatesNothing) {
+  // clay_tear: 60 x 20 x 20 mm on a table, styluses at x = 15 and 45 mm pulled 10 mm apart each.
+  const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.06, 0.01, 0.02}, 12, 4, 4);
+  SpringNetworkSetup s = test::clay_pull_setup(SpringIntegrator::symplectic_euler);
+  s.supports = {{"support", true}};
+  s.styluses = {{Eigen::Vector3d(0.015, 0.0, 0.022), 0.002}, {Eigen::Vector3d(0.045, 0.0, 0.022), 0.002}};
+  s.tearing = true;
+  s.tensile_limit = 50e3;
+  SpringNetworkModel model(mesh, s);
+  std::vector<std::vector<ToolState>> path(2001, std::vector<ToolState>(2));
+  for (int k = 0; k <= 2000; ++k) {
+    const double d = 5e-6 * k;
+    path[static_cast<std::size_t>(k)][0].position = {0.015 - d, 0.0, 0.022};
+    path[static_cast<std::size_t>(k)][1].position = {0.045 + d, 0.0, 0.022};
+  }
+  EXPECT_EQ(allocations_while_stepping(model, 2000, [&](int k) -> const std::vector<ToolState>& { return path[static_cast<std::size_t>(k)]; }), 0);
+  EXPECT_GT(model.tears(), 0); // the tearing path was exercised while counting
+}

@@ -1,0 +1,67 @@
+// The model on the clay_pull setting: the network around the stylus, its supports and
+// attachment, and the pull force from the three integrators.
+
+#include "tests/realtime/springs/model_fixtures.hpp"
+
+#include <gtest/gtest.h>
+
+namespace kerf {
+namespace {
+
+TEST(SpringNetworkModel, BuildsAroundTheStylus) {
+  const TetMesh mesh = test::clay_pull_mesh();
+  const SpringNetworkModel model(mesh, test::clay_pull_setup(SpringIntegrator::symplectic_euler));
+  const SpringNetwork& net = model.network();
+  // Block side = smallest body extent (20 mm), N = 8: h = 2.5 mm, shifted into the body: x in
+  // [10, 30] mm, y in [-10, 10] mm, z in [0, 20] mm — all 512 cells inside.
+  EXPECT_NEAR(net.block.cell_size, 2.5e-3, 1e-15);
+  EXPECT_NEAR(net.block.origin.x(), 0.01, 1e-12);
+  EXPECT_NEAR(net.block.origin.z(), 0.0, 1e-12);
+  EXPECT_EQ(net.cell_count(), 512);
+  int base = 0, boundary = 0, free_top = 0;
+  for (int p = 0; p < net.node_count; ++p) {
+    const Eigen::Vector3d r = net.rest.col(p);
+    const bool fixed = net.constraint[static_cast<std::size_t>(p)] == fix_all;
+    if (r.z() < 1e-9) base += fixed;
+    else if (std::abs(r.x() - 0.01) < 1e-9 || std::abs(r.x() - 0.03) < 1e-9 || std::abs(std::abs(r.y()) - 0.01) < 1e-9)
+      boundary += fixed;
+    else if (std::abs(r.z() - 0.02) < 1e-9 && !fixed) ++free_top;
+  }
+  EXPECT_EQ(base, 81);           // bonded base: 9 x 9 nodes
+  EXPECT_EQ(boundary, 4 * 8 * 8); // block faces inside the body, above the base
+  // Attached: nodes within r + h/2 = 3.25 mm of the tip centre (20, 0, 22) mm: the top-face
+  // node under it and its four neighbours at 2.5 mm (distance √(2.5² + 2²) = 3.2 mm).
+  EXPECT_EQ(model.attached_nodes(0), 5);
+  EXPECT_EQ(free_top, 7 * 7 - 5);
+}
+
+TEST(SpringNetworkModel, PullForceFromEachIntegrator) {
+  const TetMesh mesh = test::clay_pull_mesh();
+  std::vector<double> final_force;
+  for (const SpringIntegrator integrator :
+       {SpringIntegrator::quasi_static, SpringIntegrator::implicit_euler, SpringIntegrator::symplectic_euler}) {
+    SpringNetworkModel model(mesh, test::clay_pull_setup(integrator));
+    std::array<ToolState, 1> tool;
+    std::array<ForceSample, 1> force;
+    const double dt = 1e-3;
+    // Pull up 0.5 mm at 5 mm/s, then hold 0.2 s.
+    for (int k = 0; k <= 300; ++k) {
+      tool[0].position = Eigen::Vector3d(0.02, 0.0, 0.022 + 5e-3 * dt * std::min(k, 100));
+      model.step(tool, dt, force);
+      ASSERT_TRUE(force[0].force.allFinite());
+      EXPECT_FALSE(force[0].over_budget) << to_string(integrator) << " sample " << k;
+      EXPECT_EQ(force[0].mode, InteractionMode::deformation_1);
+    }
+    // The body pulls the stylus back down.
+    EXPECT_LT(force[0].force.z(), 0.0);
+    EXPECT_NEAR(force[0].force.x(), 0.0, 1e-6 * std::abs(force[0].force.z()));
+    final_force.push_back(force[0].force.z());
+  }
+  // After the hold the dynamic integrators settle on the static equilibrium (η = 10 Pa s
+  // damps them; the static solution is the independent value).
+  EXPECT_NEAR(final_force[1], final_force[0], 0.02 * std::abs(final_force[0]));
+  EXPECT_NEAR(final_force[2], final_force[0], 0.10 * std::abs(final_force[0]));
+}
+
+} // namespace
+} // namespace kerf
