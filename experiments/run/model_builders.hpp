@@ -14,4 +14,8 @@ BuiltModel build_fracture_model(const Scene& scene, const TetMesh& mesh);
 void require_edge_inputs(const Scene& scene);
 BuiltModel build_edge_model(const Scene& scene, const TetMesh& mesh);
 
+/// Paper 002, realtime/voxel (voxel_builder.cpp).
+void require_voxel_inputs(const Scene& scene);
+BuiltModel build_voxel_model(const Scene& scene, const TetMesh& mesh);
+
 } // namespace kerf

@@ -24,6 +24,11 @@ const CatalogueEntry catalogue[] = {
       PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction, Phenomenon::layers},
       "one blade"},
      &require_edge_inputs, &build_edge_model},
+    {{"voxel", "polygon surface + local voxel grid: surface points advanced past critical forces, DCS, clip friction (Eq. 1)",
+      "paper 002 §2.3-2.4, Table 1",
+      PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction},
+      "one sphere (cutting stick)"},
+     &require_voxel_inputs, &build_voxel_model},
 };
 
 const std::vector<ModelDescription> descriptions = [] {

@@ -82,6 +82,8 @@ struct VoxelModelSettings {
   double critical_force_depth = 0.0;    ///< [N]
   double advance_length = 0.0;          ///< [m]
   std::array<int, 3> grid{10, 20, 20};  ///< local voxel grid cells (paper 002 §4: 10x20x20)
+  bool depth_cutting_stiffness = true;  ///< DCS of paper 002 §2.4 on (Figs. 6-7 cases c, d) or off (a)
+  bool clip_friction = true;            ///< CFF of paper 002 Eq. (1) on (case d) or off (a, c)
 };
 
 struct Scene {

@@ -638,7 +638,7 @@ private:
 
   VoxelModelSettings read_voxel(const TableRef& t) const {
     allow_only(t, {"elastic_coefficient", "friction_coefficient", "damping_coefficient", "critical_force_cutting",
-                   "critical_force_depth", "advance_length", "grid"});
+                   "critical_force_depth", "advance_length", "grid", "depth_cutting_stiffness", "clip_friction"});
     VoxelModelSettings v;
     v.elastic_coefficient = required_quantity(t, "elastic_coefficient", Dimension::pressure);
     check(v.elastic_coefficient > 0.0, t, "elastic_coefficient", "a coefficient > 0");
@@ -660,6 +660,14 @@ private:
         const auto* i = a->get(k)->as_integer();
         if (i == nullptr || i->get() < 1 || i->get() > 100000) wrong(*n, t, t.key("grid"), expected);
         v.grid[k] = static_cast<int>(i->get());
+      }
+    }
+    for (const auto& [key, flag] : {std::pair{"depth_cutting_stiffness", &v.depth_cutting_stiffness},
+                                    std::pair{"clip_friction", &v.clip_friction}}) {
+      if (const toml::node* n = t.find(key)) {
+        const auto* b = n->as_boolean();
+        if (b == nullptr) wrong(*n, t, t.key(key), "true or false");
+        *flag = b->get();
       }
     }
     return v;

@@ -1,0 +1,132 @@
+// The voxel model (paper 002) built by the catalogue on the sponge scenes as a user runs them
+// (gmsh meshes, the scenes' trajectories and [models.voxel] = Table 1), the DCS/CFF switches of
+// the scene file, and the refusal of blade scenes. Kept beside the model's own tests (this
+// program links kerf_experiments).
+
+#include "experiments/run/model_catalogue.hpp"
+#include "experiments/run/run_model.hpp"
+#include "experiments/run/scene_mesh.hpp"
+#include "experiments/scene/scene_reader.hpp"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+using namespace kerf;
+
+namespace {
+
+std::filesystem::path scene_file(const std::string& name) {
+  return std::filesystem::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / (name + ".toml");
+}
+
+struct SceneRun {
+  Scene scene;
+  BuiltModel built;
+  ForceProfile profile;
+};
+
+SceneRun run(const Scene& scene) {
+  SceneRun r{scene, {}, {}};
+  const TetMesh mesh = scene_mesh(r.scene);
+  r.built = make_model("voxel", r.scene, mesh);
+  r.profile = run_model(*r.built.model, {r.scene.tools.front().name}, sample_scene_trajectories(r.scene));
+  return r;
+}
+
+/// Mean force against the cut (-f_x) over the rows of the cut phase (x between 0.15 and
+/// 0.85 mm, tip deeper than 0.02 mm): first and last fifth.
+std::pair<double, double> cut_force_fifths(const ForceProfile& p) {
+  std::vector<double> fx;
+  for (const ProfileRow& row : p.rows)
+    if (row.mode == InteractionMode::cutting && row.position.x() > 0.15e-3 && row.position.x() < 0.85e-3)
+      fx.push_back(-row.force.x());
+  const std::size_t n = fx.size() / 5;
+  double first = 0.0, last = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    first += fx[k] / static_cast<double>(n);
+    last += fx[fx.size() - n + k] / static_cast<double>(n);
+  }
+  return {first, last};
+}
+
+} // namespace
+
+TEST(VoxelOnScenes, TableOneIsReadInThePapersMillimetreUnit) {
+  const Scene scene = read_scene(scene_file("sponge_cut_constant"));
+  const SceneRun r = run(scene);
+  // docs/models.md (voxel): "20.0 N/m^2" -> E = 20 N/mm^2 = 2e7 Pa, k_e = E x 1 mm = 2e4 N/m;
+  // "0.5 N s/m^2" -> b = 0.5 N s/mm = 500 N s/m.
+  EXPECT_DOUBLE_EQ(r.built.parameters["contact_stiffness_N_per_m"].get<double>(), 2e4);
+  EXPECT_DOUBLE_EQ(r.built.parameters["clip_modulus_Pa"].get<double>(), 2e7);
+  EXPECT_DOUBLE_EQ(r.built.parameters["damping_N_s_per_m"].get<double>(), 500.0);
+  EXPECT_TRUE(r.built.parameters["depth_cutting_stiffness"].get<bool>());
+  EXPECT_TRUE(r.built.parameters["clip_friction"].get<bool>());
+}
+
+TEST(VoxelOnScenes, SpongeCutsGiveFlatAndGrowingCuttingForces) {
+  // Paper 002 Fig. 5: constant depth (0.5 mm) -> flat; proportional depth (0 -> 0.5 mm) ->
+  // growing, as the DCS 0.066 E d follows the depth d (0.66 N at 0.5 mm).
+  const SceneRun constant = run(read_scene(scene_file("sponge_cut_constant")));
+  const SceneRun proportional = run(read_scene(scene_file("sponge_cut_proportional")));
+  for (const SceneRun* r : {&constant, &proportional}) {
+    for (const ProfileRow& row : r->profile.rows) ASSERT_TRUE(row.force.allFinite());
+    // The cut runs from x = 0.1 mm to 0.9 mm: Cl at the end ~0.8 mm.
+    EXPECT_NEAR(r->profile.rows.back().crack_extent, 0.8e-3, 0.05e-3) << r->scene.name;
+    EXPECT_EQ(r->profile.rows.front().mode, InteractionMode::no_contact);
+    EXPECT_EQ(r->profile.rows.back().mode, InteractionMode::no_contact);
+  }
+  const auto [c_first, c_last] = cut_force_fifths(constant.profile);
+  const auto [p_first, p_last] = cut_force_fifths(proportional.profile);
+  EXPECT_NEAR(c_first, c_last, 0.1 * c_last);
+  EXPECT_GT(p_last - p_first, 0.3);
+}
+
+TEST(VoxelOnScenes, DcsAndClipFrictionSwitchFromTheSceneFile) {
+  // The paper's case a) (neither), read from a copy of the scene with both keys false.
+  std::ifstream in(scene_file("sponge_cut_constant"));
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string toml = text.str();
+  const std::string anchor = "grid = [10, 20, 20]";
+  ASSERT_NE(toml.find(anchor), std::string::npos);
+  toml.replace(toml.find(anchor), anchor.size(), anchor + "\ndepth_cutting_stiffness = false\nclip_friction = false");
+  const std::filesystem::path copy = std::filesystem::temp_directory_path() / "kerf_voxel_case_a.toml";
+  std::ofstream(copy) << toml;
+  Scene scene = read_scene(copy);
+  EXPECT_FALSE(scene.voxel->depth_cutting_stiffness);
+  EXPECT_FALSE(scene.voxel->clip_friction);
+  const SceneRun case_a = run(scene);
+  const SceneRun case_d = run(read_scene(scene_file("sponge_cut_constant")));
+  const auto [a_first, a_last] = cut_force_fifths(case_a.profile);
+  const auto [d_first, d_last] = cut_force_fifths(case_d.profile);
+  // Case a) feels only the point cut (wall force up to 0.1 N, friction of the bottom); case d)
+  // adds the DCS 0.66 N at 0.5 mm depth (paper 002 Fig. 7: a) below the measured force).
+  EXPECT_LT(a_last, 0.2);
+  EXPECT_NEAR(d_last - a_last, 0.66, 0.05);
+  // A switch that is not a boolean is an error naming the key.
+  toml.replace(toml.find("clip_friction = false"), 21, "clip_friction = 1");
+  std::ofstream(copy) << toml;
+  try {
+    read_scene(copy);
+    ADD_FAILURE() << "a non-boolean clip_friction was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("clip_friction"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(copy);
+}
+
+TEST(VoxelOnScenes, RefusesBladeScenesAndScenesWithoutTableOne) {
+  for (const char* name : {"potato_rect_cut", "potato_wedge_cut", "liver_prism_cut"}) {
+    const Scene s = read_scene(scene_file(name));
+    try {
+      require_model_for_scene("voxel", s);
+      ADD_FAILURE() << name << " was accepted";
+    } catch (const ModelMismatch& e) {
+      EXPECT_NE(std::string(e.what()).find("sphere"), std::string::npos) << e.what();
+    }
+  }
+  // clay_pull: one sphere, but no [models.voxel] (and no cutting).
+  EXPECT_THROW(require_model_for_scene("voxel", read_scene(scene_file("clay_pull"))), ModelMismatch);
+}
