@@ -7,7 +7,9 @@
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "realtime/fracture/contact_length.hpp"
+#include "realtime/haptics/session_file.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -20,7 +22,28 @@ struct RunOptions {
   std::string scene;
   std::string model;
   std::string out;
+  std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
 };
+
+/// The tool positions of a recorded haptic session (realtime/haptics/session_file.hpp), one
+/// trajectory per scene tool, matched by name, at the session's servo rate.
+std::vector<SampledTrajectory> session_trajectories(const std::string& file, const std::vector<std::string>& tools) {
+  const Session session = read_session(file);
+  const auto states = session_tool_states(session);
+  std::vector<SampledTrajectory> out;
+  for (const std::string& name : tools) {
+    const auto& recorded = session.header.tools;
+    const auto at = std::find(recorded.begin(), recorded.end(), name);
+    if (at == recorded.end()) throw std::invalid_argument(file + ": the session has no tool named " + name);
+    if (session.ticks.empty()) throw std::invalid_argument(file + ": the session has no ticks");
+    SampledTrajectory t;
+    t.rate = session.header.rate;
+    t.samples = states[static_cast<std::size_t>(at - recorded.begin())];
+    t.labels.assign(t.samples.size(), "session");
+    out.push_back(std::move(t));
+  }
+  return out;
+}
 
 /// The paper 001 check printed after a cutting run: the steady cutting force beside J_c l
 /// (Eq. 10), l measured on the mesh at the median cutting sample.
@@ -62,7 +85,8 @@ void run_run(const RunOptions& o) {
   BuiltModel built = make_model(o.model, scene, mesh);
   std::vector<std::string> names;
   for (const Tool& t : scene.tools) names.push_back(t.name);
-  const ForceProfile profile = run_model(*built.model, names, sample_scene_trajectories(scene));
+  const ForceProfile profile = run_model(
+      *built.model, names, o.trajectory.empty() ? sample_scene_trajectories(scene) : session_trajectories(o.trajectory, names));
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   write_run(out, profile, run_manifest(scene, built, mesh, profile, wall));
 
@@ -86,6 +110,7 @@ void add_run_command(CLI::App& app) {
   run->add_option("scene", options->scene, "scene file or name")->required();
   run->add_option("--model", options->model, "model name (see `kerf models`)")->required();
   run->add_option("-o,--output", options->out, "output directory (default runs/SCENE/MODEL)");
+  run->add_option("--trajectory", options->trajectory, "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   run->callback([options] { run_run(*options); });
 }
 

@@ -16,6 +16,8 @@ std::filesystem::path resolve_scene(const std::string& argument);
 void add_mesh_command(CLI::App& app);   ///< kerf mesh SCENE [-o DIR]
 void add_run_command(CLI::App& app);    ///< kerf run SCENE --model M [-o DIR]
 void add_models_command(CLI::App& app); ///< kerf models
+void add_haptic_command(CLI::App& app);     ///< kerf haptic SCENE --model M --device ADDRESS... (the live rig)
+void add_device_sim_command(CLI::App& app); ///< kerf device-sim SCENE [--port P]... (emulated devices)
 void add_stability_command(CLI::App& app); ///< kerf stability SCENE --model M [-o DIR]
 
 } // namespace kerf::cli

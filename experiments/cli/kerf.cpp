@@ -15,6 +15,8 @@ int main(int argc, char** argv) {
   kerf::cli::add_mesh_command(app);
   kerf::cli::add_run_command(app);
   kerf::cli::add_models_command(app);
+  kerf::cli::add_haptic_command(app);
+  kerf::cli::add_device_sim_command(app);
   kerf::cli::add_stability_command(app);
   try {
     app.parse(argc, argv);

@@ -217,6 +217,7 @@ bool ServoLoop::tick(double now, double late) noexcept {
 
 void ServoLoop::servo_thread() {
   if (m_settings.realtime) m_realtime = enter_realtime(m_settings.priority);
+  if (m_settings.on_realtime) m_settings.on_realtime(m_realtime);
   run_periodic(m_settings.rate, m_timing, nullptr, [this](double now, double late) { return tick(now, late); });
   m_model_thread_done.store(true, std::memory_order_relaxed);
 }

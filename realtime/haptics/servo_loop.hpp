@@ -17,6 +17,7 @@
 #include "realtime/tool_model.hpp"
 
 #include <atomic>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -30,6 +31,9 @@ struct ServoSettings {
   SafetyLimits safety;        ///< applied to every device
   bool realtime = true;       ///< try SCHED_FIFO and mlockall (falls back with a warning)
   int priority = 80;          ///< SCHED_FIFO priority of the servo thread (the model thread gets one less)
+  /// Called once from the servo thread, before its first tick, with what real-time setup it got
+  /// (so a command line can warn at the start of a session). May be empty.
+  std::function<void(const RealtimeSetup&)> on_realtime;
 };
 
 /// What a session did.

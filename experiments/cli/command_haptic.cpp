@@ -1,0 +1,159 @@
+// kerf haptic SCENE --model M --device ADDRESS [--device ADDRESS] [--rate HZ] [--record FILE] ...:
+// the live rig (realtime/haptics, docs/haptic-rig.md). One device per tool of the scene, in
+// scene order; SIGINT/SIGTERM (or a device's e-stop button) is an emergency stop.
+
+#include "experiments/cli/commands.hpp"
+#include "experiments/run/model_catalogue.hpp"
+#include "experiments/run/scene_mesh.hpp"
+#include "experiments/scene/scene_reader.hpp"
+#include "realtime/haptics/servo_loop.hpp"
+#include "realtime/haptics/udp_device.hpp"
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+
+namespace kerf::cli {
+
+namespace {
+
+struct HapticOptions {
+  std::string scene;
+  std::string model;
+  std::vector<std::string> devices;
+  double rate = 1000.0;
+  double model_rate = 0.0;
+  std::string record;
+  double duration = 0.0;
+  double max_force = 8.5;
+  double force_rate = 1000.0;
+  double ramp = 0.2;
+  double watchdog = 0.05;
+  bool no_realtime = false;
+};
+
+/// The session being run, for the signal handler (an atomic pointer: async-signal-safe to read).
+std::atomic<ServoLoop*> running_loop{nullptr};
+
+extern "C" void emergency_signal(int) {
+  if (ServoLoop* loop = running_loop.load()) loop->request_emergency_stop();
+}
+
+void print_histogram(const char* name, const DurationHistogram& h) {
+  std::printf("  %-14s p50 %8.2f us  p99 %8.2f us  p99.9 %8.2f us  max %8.2f us  (n = %llu)\n", name,
+              h.percentile(50) * 1e6, h.percentile(99) * 1e6, h.percentile(99.9) * 1e6, h.max() * 1e6,
+              static_cast<unsigned long long>(h.count()));
+}
+
+void run_haptic(const HapticOptions& o) {
+  const Scene scene = read_scene(resolve_scene(o.scene));
+  require_model_for_scene(o.model, scene);
+  if (o.devices.size() != scene.tools.size())
+    throw std::invalid_argument("haptic: scene " + scene.name + " has " + std::to_string(scene.tools.size()) +
+                                " tool(s); give one --device per tool, in scene order (got " +
+                                std::to_string(o.devices.size()) + ")");
+  const TetMesh mesh = scene_mesh(scene);
+  BuiltModel built = make_model(o.model, scene, mesh);
+
+  std::vector<std::unique_ptr<HapticDevice>> devices;
+  std::vector<HapticDevice*> raw;
+  std::vector<std::string> tool_names;
+  for (std::size_t i = 0; i < o.devices.size(); ++i) {
+    devices.push_back(open_device(o.devices[i]));
+    raw.push_back(devices.back().get());
+    tool_names.push_back(scene.tools[i].name);
+    std::printf("tool %s <- device %s\n", scene.tools[i].name.c_str(), o.devices[i].c_str());
+  }
+
+  ServoSettings settings;
+  settings.rate = o.rate;
+  settings.model_rate = o.model_rate;
+  settings.duration = o.duration;
+  settings.safety = {o.max_force, o.force_rate, o.ramp, o.watchdog};
+  settings.realtime = !o.no_realtime;
+  settings.on_realtime = [&o](const RealtimeSetup& r) {
+    if (o.no_realtime) std::fprintf(stderr, "kerf haptic: real-time scheduling not requested (--no-realtime)\n");
+    else if (r.fifo && r.locked) std::fprintf(stderr, "kerf haptic: servo thread SCHED_FIFO, memory locked\n");
+    else std::fputs(r.warnings.c_str(), stderr);
+  };
+  std::unique_ptr<SessionRecorder> recorder;
+  if (!o.record.empty()) {
+    const double seconds = 2.0; // ring of 2 s of ticks: the writer drains it every 20 ms
+    recorder = std::make_unique<SessionRecorder>(o.record, SessionHeader{o.rate, o.model, scene.name, tool_names},
+                                                 static_cast<std::size_t>(seconds * o.rate));
+  }
+  ServoLoop loop(*built.model, raw, settings, recorder.get());
+
+  struct sigaction action {};
+  action.sa_handler = emergency_signal;
+  sigemptyset(&action.sa_mask);
+  struct sigaction old_int {}, old_term {};
+  running_loop.store(&loop);
+  sigaction(SIGINT, &action, &old_int);
+  sigaction(SIGTERM, &action, &old_term);
+  std::printf("%s / %s at %.0f Hz%s%s; Ctrl-C is an emergency stop\n", scene.name.c_str(), o.model.c_str(), o.rate,
+              o.model_rate > 0.0 ? (", model thread at " + std::to_string(static_cast<int>(o.model_rate)) + " Hz").c_str()
+                                 : "",
+              o.duration > 0.0 ? (", " + std::to_string(o.duration) + " s").c_str() : ", until stopped");
+  std::fflush(stdout);
+  const ServoReport report = loop.run();
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  running_loop.store(nullptr);
+  if (recorder) recorder->close();
+
+  const TimingStatistics& t = report.timing;
+  std::printf("%s: %llu ticks, %llu model steps, %llu overruns, %llu missed deadlines%s\n",
+              report.emergency_stopped ? "emergency stop" : "session ended", static_cast<unsigned long long>(t.ticks),
+              static_cast<unsigned long long>(report.model_steps), static_cast<unsigned long long>(t.overruns),
+              static_cast<unsigned long long>(t.missed_deadlines), report.realtime.fifo ? " (SCHED_FIFO)" : "");
+  print_histogram("wake lateness", t.lateness);
+  print_histogram("period jitter", t.period_jitter);
+  print_histogram("model compute", o.model_rate > 0.0 ? report.model_timing.compute : t.compute);
+  print_histogram("whole tick", t.tick);
+  for (std::size_t i = 0; i < report.links.size(); ++i) {
+    const LinkCounters& c = report.links[i];
+    const SafetyCounters& s = report.safety[i];
+    std::printf("device %s: received %llu, accepted %llu, malformed %llu, wrong version %llu, duplicated %llu, "
+                "stale %llu, lost %llu\n",
+                o.devices[i].c_str(), static_cast<unsigned long long>(c.received),
+                static_cast<unsigned long long>(c.accepted), static_cast<unsigned long long>(c.malformed),
+                static_cast<unsigned long long>(c.unsupported_version), static_cast<unsigned long long>(c.duplicated),
+                static_cast<unsigned long long>(c.stale), static_cast<unsigned long long>(c.lost));
+    std::printf("  safety: clamped %llu, rate-limited %llu, non-finite %llu, watchdog %llu, e-stop %llu ticks; "
+                "passivity observer: %.6f J injected\n",
+                static_cast<unsigned long long>(s.clamped), static_cast<unsigned long long>(s.rate_limited),
+                static_cast<unsigned long long>(s.non_finite), static_cast<unsigned long long>(s.watchdog),
+                static_cast<unsigned long long>(s.emergency), report.injected_energy[i]);
+  }
+  if (recorder)
+    std::printf("wrote %s (%llu ticks, %llu dropped)\n", o.record.c_str(),
+                static_cast<unsigned long long>(recorder->written()), static_cast<unsigned long long>(recorder->dropped()));
+}
+
+} // namespace
+
+void add_haptic_command(CLI::App& app) {
+  auto o = std::make_shared<HapticOptions>();
+  auto* c = app.add_subcommand("haptic", "drive haptic device(s) with a model: the live rig (docs/haptic-rig.md)");
+  c->add_option("scene", o->scene, "scene file or name")->required();
+  c->add_option("--model", o->model, "model name (see `kerf models`)")->required();
+  c->add_option("--device", o->devices, "udp://HOST:PORT or replay:FILE, one per tool in scene order")->required();
+  c->add_option("--rate", o->rate, "servo rate [Hz] (100..10000)")->capture_default_str();
+  c->add_option("--model-rate", o->model_rate,
+                "run the model in its own thread at this rate [Hz] (< rate; the servo interpolates); 0 = in the servo "
+                "thread")
+      ->capture_default_str();
+  c->add_option("--record", o->record, "session file to record every tick to (append-only CSV)");
+  c->add_option("--duration", o->duration, "seconds until the ramp out begins; 0 = until Ctrl-C")->capture_default_str();
+  c->add_option("--max-force", o->max_force, "force clamp [N] (the device's declared maximum applies too)")
+      ->capture_default_str();
+  c->add_option("--force-rate", o->force_rate, "force-rate limit [N/s]")->capture_default_str();
+  c->add_option("--ramp", o->ramp, "ramp in/out time [s]")->capture_default_str();
+  c->add_option("--watchdog", o->watchdog, "zero force after this much link silence [s]")->capture_default_str();
+  c->add_flag("--no-realtime", o->no_realtime, "do not ask for SCHED_FIFO and locked memory");
+  c->callback([o] { run_haptic(*o); });
+}
+
+} // namespace kerf::cli

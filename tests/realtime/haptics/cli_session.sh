@@ -1,0 +1,68 @@
+#!/usr/bin/env bash
+# The live rig from the command line, as an experimenter runs it, over loopback:
+#  1. kerf device-sim + kerf haptic --record: the session's model forces equal an offline
+#     `kerf run --trajectory SESSION` of the same scene (to 1e-9 N, the model is deterministic);
+#  2. device-sim killed with SIGKILL mid-session: every tick whose link is older than the 50 ms
+#     watchdog commands exactly zero, and there are such ticks;
+#  3. SIGTERM to kerf haptic is an emergency stop: it exits 0 and says so.
+# Ports are picked by the kernel (--port 0) and read from device-sim's output, so parallel runs
+# do not collide. Usage: cli_session.sh KERF SCENE WORKDIR
+set -euo pipefail
+KERF=$1 SCENE=$2 WORK=$3
+rm -rf "$WORK" && mkdir -p "$WORK" && cd "$WORK"
+
+start_sim() { # $1 = log file; prints the port
+  "$KERF" device-sim "$SCENE" --port 0 --hand-stiffness 3000 --hold 0.3 --tail 0.3 "${@:2}" > "$1" 2>&1 &
+  SIM=$!
+  for _ in $(seq 100); do grep -q "udp://" "$1" && break; sleep 0.05; done
+  PORT=$(sed -n 's|.*udp://127.0.0.1:\([0-9]*\),.*|\1|p' "$1" | head -1)
+  [ -n "$PORT" ] || { cat "$1"; echo "device-sim did not start"; exit 1; }
+}
+
+wait_ticks() { # $1 = session file, $2 = rows: wait (at most 120 s) until the rig has recorded them
+  for _ in $(seq 1200); do [ -f "$1" ] && [ "$(wc -l < "$1")" -gt "$2" ] && return 0; sleep 0.1; done
+  echo "the rig never recorded $2 rows in $1"; exit 1
+}
+
+# 1. session vs offline run
+start_sim sim1.log --record received.csv
+"$KERF" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --duration 2.3 --record session.csv \
+  --no-realtime > haptic1.log 2>&1
+wait $SIM
+"$KERF" run "$SCENE" --model fracture --trajectory session.csv -o offline > run.log
+# session rows: 3 header lines, model force in columns 15-17; profile: 1 header line, force in 6-8
+paste -d, <(tail -n +4 session.csv | cut -d, -f15-17,21) <(tail -n +2 offline/profile.csv | cut -d, -f6-9) |
+  awk -F, '{ d = 0; for (i = 1; i <= 3; ++i) { e = $i - $(i + 4); if (e < 0) e = -e; if (e > d) d = e }
+             if (d > 1e-9 || $4 != $8) { print "row " NR ": session " $0; bad = 1 }
+             if ($4 == "cutting") cut = 1; n++ }
+           END { if (n < 1000) { print "only " n " ticks"; bad = 1 } if (!cut) { print "no cutting"; bad = 1 }
+                 exit bad }'
+[ "$(tail -n +2 received.csv | wc -l)" -gt 1000 ] || { echo "device-sim received too few commands"; exit 1; }
+echo "1. session matches the offline run ($(tail -n +4 session.csv | wc -l) ticks)"
+
+# 2. SIGKILL the device mid-session
+start_sim sim2.log
+"$KERF" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --duration 6 --record killed.csv \
+  --no-realtime > haptic2.log 2>&1 &
+RIG=$!
+wait_ticks killed.csv 500 # the rig is live (meshing first takes a while on a loaded machine)
+kill -KILL $SIM
+wait $SIM || true
+wait $RIG
+# column 25 = link_age_s, 18-20 = commanded force
+tail -n +4 killed.csv | awk -F, '$25 > 0.05 { silent++; if ($18 != 0 || $19 != 0 || $20 != 0) { print "nonzero force at link age " $25 ": " $0; bad = 1 } }
+  END { if (silent < 100) { print "only " silent " silent ticks"; bad = 1 } exit bad }'
+echo "2. killed device: zero force once the link is older than the watchdog time"
+
+# 3. SIGTERM to the rig is an emergency stop
+start_sim sim3.log
+"$KERF" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --no-realtime --record estop.csv \
+  > haptic3.log 2>&1 &
+RIG=$!
+wait_ticks estop.csv 300
+kill -TERM $RIG
+wait $RIG
+grep -q "emergency stop" haptic3.log || { cat haptic3.log; echo "no emergency stop reported"; exit 1; }
+kill -INT $SIM 2>/dev/null || true
+wait $SIM || true
+echo "3. SIGTERM: emergency stop, exit 0"
