@@ -12,7 +12,8 @@ build="${KERF_BUILD_DIR:-$here/build}"
 # Debian packages kerf builds and tests with (DESIGN.md, "Libraries").
 packages=(cmake g++ make pkg-config git
           libeigen3-dev libgmsh-dev libvtk9-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
-          libssl-dev libgtest-dev libbenchmark-dev python3-matplotlib)
+          libssl-dev libgtest-dev libbenchmark-dev python3-matplotlib
+          libdeal.ii-dev libopenblas0-pthread openmpi-bin)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,0 +1,684 @@
+// The deal.II side of the finite-strain reference (finite_strain_solver.hpp): triangulation from
+// TetMesh, FE space, total-Lagrangian assembly, penalty contact, Newton with line search, output.
+
+#include "reference/finite_strain_solver.hpp"
+
+#include "reference/material/decoupled_neo_hookean.hpp"
+#include "reference/material/finite_strain_error.hpp"
+#include "reference/material/neo_hookean.hpp"
+#include "reference/material/st_venant_kirchhoff.hpp"
+#include "reference/tangent_solver.hpp"
+
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_simplex_p.h>
+#include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/fe/mapping_fe.h>
+#include <deal.II/grid/tria.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/sparse_matrix.h>
+#include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/vector.h>
+#include <deal.II/numerics/data_out.h>
+#include <deal.II/numerics/data_postprocessor.h>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+
+namespace kerf::reference {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+Eigen::Matrix3d to_eigen(const dealii::Tensor<2, 3>& t) {
+  Eigen::Matrix3d m;
+  for (unsigned i = 0; i < 3; ++i)
+    for (unsigned j = 0; j < 3; ++j) m(i, j) = t[i][j];
+  return m;
+}
+Eigen::Vector3d to_eigen(const dealii::Point<3>& p) { return {p[0], p[1], p[2]}; }
+
+std::unique_ptr<HyperelasticLaw> make_law(const MaterialRegion& region) {
+  const LameParameters lame = lame_parameters(region.youngs_modulus, region.poisson_ratio);
+  switch (region.law) {
+  case LawKind::neo_hookean: return std::make_unique<NeoHookean>(lame.mu, lame.lambda);
+  case LawKind::decoupled_neo_hookean:
+    // κ = λ + 2μ/3 (code gallery: 2μ(1+ν) / (3(1−2ν)))
+    return std::make_unique<DecoupledNeoHookean>(lame.mu, lame.lambda + 2.0 * lame.mu / 3.0);
+  case LawKind::st_venant_kirchhoff: return std::make_unique<StVenantKirchhoff>(lame.mu, lame.lambda);
+  }
+  throw std::invalid_argument("finite strain solver: unknown material law");
+}
+
+} // namespace
+
+struct FiniteStrainSolver::Impl {
+  SolverSettings settings;
+  std::vector<std::string> surface_names;
+  dealii::Triangulation<3> tria;
+  std::unique_ptr<dealii::FESystem<3>> fe;
+  std::unique_ptr<dealii::MappingFE<3>> mapping;
+  dealii::DoFHandler<3> dof;
+  std::unique_ptr<dealii::QGaussSimplex<3>> cell_quadrature;
+  std::unique_ptr<dealii::QGaussSimplex<2>> face_quadrature;
+  std::vector<std::unique_ptr<HyperelasticLaw>> laws; // by material_id
+  std::vector<double> youngs; // by material_id
+
+  // Dirichlet DOFs and how to get their target value.
+  struct DirichletDof {
+    dealii::types::global_dof_index index;
+    unsigned component;
+    int boundary; // index into displacement_boundaries
+    Eigen::Vector3d X;
+  };
+  std::vector<DirichletDof> dirichlet;
+  std::vector<DisplacementBoundary> boundaries;
+  std::vector<std::pair<int, Eigen::Vector3d>> tractions; // surface group, traction [Pa]
+  std::vector<std::vector<int>> face_classes;               // boundary_id -> surface groups
+  bool in_group(dealii::types::boundary_id id, int group) const {
+    const auto& c = face_classes[id];
+    return std::find(c.begin(), c.end(), group) != c.end();
+  }
+  std::optional<RigidToolShape> tool;
+  double penalty = 0.0;
+
+  dealii::SparsityPattern pattern;
+  dealii::SparseMatrix<double> K;
+  dealii::Vector<double> u;
+  std::unique_ptr<TangentSolver> linear;
+
+  // Result of one assembly.
+  struct Assembly {
+    dealii::Vector<double> residual; // f_int − f_ext − f_contact, all DOFs
+    double internal_norm = 0.0;      // |f_int|
+    double external_norm = 0.0;      // |f_ext + f_contact|
+    Eigen::Vector3d contact_on_body = Eigen::Vector3d::Zero();
+    Eigen::Vector3d traction_on_body = Eigen::Vector3d::Zero();
+    int contact_points = 0;
+    double contact_area = 0.0;
+    double max_pressure = 0.0;
+  };
+
+  double dirichlet_target(const DirichletDof& d, double load) const {
+    const DisplacementBoundary& b = boundaries[static_cast<std::size_t>(d.boundary)];
+    if (b.kind != DisplacementBoundary::Kind::prescribed) return 0.0;
+    return b.displacement(d.X, load)[d.component];
+  }
+
+  void build(const FiniteStrainProblem& problem);
+  void assemble(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix, Assembly& out,
+                const dealii::AffineConstraints<double>* constraints, dealii::Vector<double>* rhs);
+  double free_norm(const dealii::Vector<double>& r) const {
+    dealii::Vector<double> copy = r;
+    for (const auto& d : dirichlet) copy[d.index] = 0.0;
+    return copy.l2_norm();
+  }
+};
+
+void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
+  const TetMesh& mesh = problem.mesh;
+  if (settings.degree != 1 && settings.degree != 2)
+    throw std::invalid_argument("finite strain solver: degree must be 1 or 2, got " + std::to_string(settings.degree));
+  if (settings.refinements < 0 || settings.refinements > 4)
+    throw std::invalid_argument("finite strain solver: refinements must lie in [0, 4], got " +
+                                std::to_string(settings.refinements));
+  if (mesh.tets.rows() == 0) throw std::invalid_argument("finite strain solver: the mesh has no tetrahedra");
+  if (problem.materials.empty()) throw std::invalid_argument("finite strain solver: no material region given");
+
+  // Materials: material_id = index of the first region containing the tet.
+  std::vector<int> material(static_cast<std::size_t>(mesh.tets.rows()), -1);
+  for (std::size_t r = 0; r < problem.materials.size(); ++r) {
+    const VolumeGroup* group = mesh.find_volume_group(problem.materials[r].volume_group);
+    if (group == nullptr)
+      throw std::invalid_argument("finite strain solver: material region '" + problem.materials[r].volume_group +
+                                  "' is not a volume group of the mesh");
+    for (int t : group->tets)
+      if (material[static_cast<std::size_t>(t)] < 0) material[static_cast<std::size_t>(t)] = static_cast<int>(r);
+    laws.push_back(make_law(problem.materials[r]));
+    youngs.push_back(problem.materials[r].youngs_modulus);
+  }
+  std::vector<dealii::Point<3>> vertices(static_cast<std::size_t>(mesh.nodes.rows()));
+  for (Eigen::Index v = 0; v < mesh.nodes.rows(); ++v)
+    vertices[static_cast<std::size_t>(v)] = dealii::Point<3>(mesh.nodes(v, 0), mesh.nodes(v, 1), mesh.nodes(v, 2));
+  std::vector<dealii::CellData<3>> cells(static_cast<std::size_t>(mesh.tets.rows()));
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
+    const int m = material[static_cast<std::size_t>(t)];
+    if (m < 0)
+      throw std::invalid_argument("finite strain solver: tetrahedron " + std::to_string(t) +
+                                  " belongs to no material region");
+    auto& cell = cells[static_cast<std::size_t>(t)];
+    cell.vertices.resize(4);
+    for (int k = 0; k < 4; ++k) cell.vertices[static_cast<std::size_t>(k)] = static_cast<unsigned>(mesh.tets(t, k));
+    // deal.II's reference tetrahedron is positively oriented: order the vertices so that
+    // det[b−a, c−a, d−a] > 0 (the same element; only its vertex order changes).
+    const Eigen::Vector3d a = mesh.nodes.row(mesh.tets(t, 0));
+    const double volume6 = (Eigen::Vector3d(mesh.nodes.row(mesh.tets(t, 1))) - a)
+                               .cross(Eigen::Vector3d(mesh.nodes.row(mesh.tets(t, 2))) - a)
+                               .dot(Eigen::Vector3d(mesh.nodes.row(mesh.tets(t, 3))) - a);
+    if (!(std::abs(volume6) > 0.0))
+      throw std::invalid_argument("finite strain solver: tetrahedron " + std::to_string(t) + " has zero volume");
+    if (volume6 < 0.0) std::swap(cell.vertices[2], cell.vertices[3]);
+    cell.material_id = static_cast<dealii::types::material_id>(m);
+  }
+  tria.create_triangulation(vertices, cells, dealii::SubCellData());
+
+  // Boundary ids: a face may lie in several surface groups (e.g. `xmin` and `boundary`), so the
+  // id numbers the distinct sets of groups ("face classes"); 0 = in no group. Refinement passes
+  // the id on to the child faces.
+  std::map<std::array<unsigned, 3>, std::vector<int>> face_groups;
+  for (std::size_t g = 0; g < mesh.surface_groups.size(); ++g) {
+    surface_names.push_back(mesh.surface_groups[g].name);
+    const Eigen::MatrixXi& tri = mesh.surface_groups[g].triangles;
+    for (Eigen::Index f = 0; f < tri.rows(); ++f) {
+      std::array<unsigned, 3> key{static_cast<unsigned>(tri(f, 0)), static_cast<unsigned>(tri(f, 1)),
+                                  static_cast<unsigned>(tri(f, 2))};
+      std::sort(key.begin(), key.end());
+      face_groups[key].push_back(static_cast<int>(g));
+    }
+  }
+  face_classes.push_back({});
+  for (const auto& cell : tria.active_cell_iterators())
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary()) continue;
+      std::array<unsigned, 3> key{cell->face(f)->vertex_index(0), cell->face(f)->vertex_index(1),
+                                  cell->face(f)->vertex_index(2)};
+      std::sort(key.begin(), key.end());
+      const auto it = face_groups.find(key);
+      const std::vector<int> groups = it == face_groups.end() ? std::vector<int>{} : it->second;
+      auto cls = std::find(face_classes.begin(), face_classes.end(), groups);
+      if (cls == face_classes.end()) cls = face_classes.insert(face_classes.end(), groups);
+      cell->face(f)->set_boundary_id(static_cast<dealii::types::boundary_id>(cls - face_classes.begin()));
+    }
+  if (settings.refinements > 0) tria.refine_global(static_cast<unsigned>(settings.refinements));
+
+  auto group_of = [&](const std::string& name, const char* what) {
+    for (std::size_t g = 0; g < surface_names.size(); ++g)
+      if (surface_names[g] == name) return static_cast<int>(g);
+    throw std::invalid_argument(std::string("finite strain solver: ") + what + " surface '" + name +
+                                "' is not a surface group of the mesh");
+  };
+
+  fe = std::make_unique<dealii::FESystem<3>>(dealii::FE_SimplexP<3>(static_cast<unsigned>(settings.degree)), 3);
+  mapping = std::make_unique<dealii::MappingFE<3>>(dealii::FE_SimplexP<3>(1));
+  cell_quadrature = std::make_unique<dealii::QGaussSimplex<3>>(static_cast<unsigned>(settings.degree + 1));
+  face_quadrature = std::make_unique<dealii::QGaussSimplex<2>>(static_cast<unsigned>(settings.degree + 1));
+  dof.reinit(tria);
+  dof.distribute_dofs(*fe);
+
+  // Support points; the node-major layout (3k + component) the AMG's block size relies on.
+  std::vector<dealii::Point<3>> support(dof.n_dofs());
+  {
+    std::vector<dealii::types::global_dof_index> local(fe->n_dofs_per_cell());
+    const auto& unit_points = fe->get_unit_support_points();
+    for (const auto& cell : dof.active_cell_iterators()) {
+      cell->get_dof_indices(local);
+      for (unsigned i = 0; i < local.size(); ++i) {
+        support[local[i]] = mapping->transform_unit_to_real_cell(cell, unit_points[i]);
+        if (local[i] % 3 != fe->system_to_component_index(i).first)
+          throw std::logic_error("finite strain solver: DOFs are not node-major (3k + component)");
+      }
+    }
+  }
+
+  // Dirichlet DOFs: bonded and prescribed first (they win over sliding on shared edges).
+  boundaries = problem.displacement_boundaries;
+  std::map<dealii::types::global_dof_index, DirichletDof> fixed;
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::size_t b = 0; b < boundaries.size(); ++b) {
+      const DisplacementBoundary& bc = boundaries[b];
+      const bool sliding = bc.kind == DisplacementBoundary::Kind::sliding;
+      if (sliding != (pass == 1)) continue;
+      const int group = group_of(bc.surface, "support");
+      std::array<bool, 3> comps{true, true, true};
+      if (bc.kind == DisplacementBoundary::Kind::prescribed) {
+        if (!bc.displacement)
+          throw std::invalid_argument("finite strain solver: prescribed surface '" + bc.surface + "' has no displacement");
+        comps = bc.components;
+      }
+      if (sliding) {
+        // u·n = 0 with n = ±e_k: every triangle of the group must have the same axis normal.
+        const SurfaceGroup* group = mesh.find_surface_group(bc.surface);
+        int axis = -1;
+        for (Eigen::Index f = 0; f < group->triangles.rows(); ++f) {
+          const Eigen::Vector3d a = mesh.nodes.row(group->triangles(f, 0));
+          const Eigen::Vector3d n = (Eigen::Vector3d(mesh.nodes.row(group->triangles(f, 1))) - a)
+                                        .cross(Eigen::Vector3d(mesh.nodes.row(group->triangles(f, 2))) - a)
+                                        .normalized();
+          Eigen::Index k = 0;
+          n.cwiseAbs().maxCoeff(&k);
+          if (std::abs(std::abs(n[k]) - 1.0) > 1e-8 || (axis >= 0 && axis != k))
+            throw std::invalid_argument("finite strain solver: sliding support '" + bc.surface +
+                                        "' must be a plane normal to a coordinate axis");
+          axis = static_cast<int>(k);
+        }
+        comps = {axis == 0, axis == 1, axis == 2};
+      }
+      std::vector<dealii::types::global_dof_index> local(fe->n_dofs_per_face());
+      for (const auto& cell : dof.active_cell_iterators())
+        for (const unsigned f : cell->face_indices()) {
+          if (!cell->face(f)->at_boundary() || !in_group(cell->face(f)->boundary_id(), group)) continue;
+          cell->face(f)->get_dof_indices(local);
+          for (unsigned i = 0; i < local.size(); ++i) {
+            const unsigned c = fe->face_system_to_component_index(i, f).first;
+            if (!comps[c] || fixed.count(local[i]) != 0) continue;
+            fixed.emplace(local[i], DirichletDof{local[i], c, static_cast<int>(b), to_eigen(support[local[i]])});
+          }
+        }
+    }
+  for (const auto& [index, d] : fixed) dirichlet.push_back(d);
+
+  for (const TractionBoundary& t : problem.tractions) {
+    const int group = group_of(t.surface, "traction");
+    double area = 0.0;
+    dealii::FEFaceValues<3> fv(*mapping, *fe, *face_quadrature, dealii::update_JxW_values);
+    for (const auto& cell : dof.active_cell_iterators())
+      for (const unsigned f : cell->face_indices())
+        if (cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), group)) {
+          fv.reinit(cell, f);
+          for (unsigned q = 0; q < fv.n_quadrature_points; ++q) area += fv.JxW(q);
+        }
+    if (!(area > 0.0)) throw std::invalid_argument("finite strain solver: traction surface '" + t.surface + "' has no area");
+    tractions.emplace_back(group, t.total_force / area);
+  }
+
+  tool = problem.tool;
+  if (tool) {
+    validate(*tool);
+    penalty = settings.contact_penalty;
+    if (penalty <= 0.0) {
+      double h_min = std::numeric_limits<double>::infinity();
+      for (const auto& cell : tria.active_cell_iterators())
+        for (unsigned l = 0; l < cell->n_lines(); ++l) h_min = std::min(h_min, cell->line(l)->diameter());
+      // ε_N = 50 E_max / h_min: a pressure E costs a penetration of h_min / 50.
+      penalty = 50.0 * *std::max_element(youngs.begin(), youngs.end()) / h_min;
+    }
+  }
+
+  dealii::AffineConstraints<double> structure;
+  for (const auto& d : dirichlet) structure.add_line(d.index);
+  structure.close();
+  dealii::DynamicSparsityPattern dsp(dof.n_dofs());
+  dealii::DoFTools::make_sparsity_pattern(dof, dsp, structure, false);
+  pattern.copy_from(dsp);
+  K.reinit(pattern);
+  u.reinit(dof.n_dofs());
+
+  const bool direct = settings.linear_solver == LinearSolverChoice::direct ||
+                      (settings.linear_solver == LinearSolverChoice::automatic && dof.n_dofs() <= settings.direct_dof_limit);
+  linear = std::make_unique<TangentSolver>(direct ? TangentSolver::Kind::direct : TangentSolver::Kind::iterative,
+                                           std::move(support), settings.iterative_tolerance);
+}
+
+void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
+                                        Assembly& out, const dealii::AffineConstraints<double>* constraints,
+                                        dealii::Vector<double>* rhs) {
+  const unsigned n = fe->n_dofs_per_cell();
+  out.residual.reinit(dof.n_dofs());
+  dealii::Vector<double> f_int(dof.n_dofs()), f_ext(dof.n_dofs());
+  out.contact_on_body.setZero();
+  out.traction_on_body.setZero();
+  out.contact_points = 0;
+  out.contact_area = 0.0;
+  out.max_pressure = 0.0;
+  if (with_matrix) {
+    K = 0.0;
+    *rhs = 0.0;
+  }
+  dealii::FEValues<3> fv(*mapping, *fe, *cell_quadrature,
+                         dealii::update_gradients | dealii::update_JxW_values);
+  dealii::FEFaceValues<3> ffv(*mapping, *fe, *face_quadrature,
+                              dealii::update_values | dealii::update_quadrature_points | dealii::update_JxW_values);
+  const dealii::FEValuesExtractors::Vector disp(0);
+  std::vector<dealii::Tensor<2, 3>> grads(cell_quadrature->size());
+  std::vector<dealii::Tensor<1, 3>> face_u(face_quadrature->size());
+  dealii::FullMatrix<double> cell_K(n, n);
+  dealii::Vector<double> cell_int(n), cell_ext(n), cell_rhs(n);
+  std::vector<dealii::types::global_dof_index> local(n);
+  std::vector<unsigned> comp(n);
+  for (unsigned i = 0; i < n; ++i) comp[i] = fe->system_to_component_index(i).first;
+  std::vector<Eigen::Vector3d> gradN(n);
+  std::vector<Eigen::Matrix<double, 9, 1>> AgradN(n);
+
+  for (const auto& cell : dof.active_cell_iterators()) {
+    fv.reinit(cell);
+    cell->get_dof_indices(local);
+    cell_K = 0.0;
+    cell_int = 0.0;
+    cell_ext = 0.0;
+    fv[disp].get_function_gradients(state, grads);
+    const HyperelasticLaw& law = *laws[cell->material_id()];
+    for (unsigned q = 0; q < fv.n_quadrature_points; ++q) {
+      // F = I + Grad u (total Lagrangian: gradients with respect to the reference configuration)
+      const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(grads[q]);
+      const double JxW = fv.JxW(q);
+      Eigen::Matrix3d S;
+      Tensor4 C4;
+      law.second_piola_and_tangent(F, S, C4);
+      const StressTangent st = first_piola_and_tangent(F, S, C4);
+      for (unsigned i = 0; i < n; ++i) {
+        const auto g = fv.shape_grad_component(i, q, comp[i]);
+        gradN[i] = Eigen::Vector3d(g[0], g[1], g[2]);
+        // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
+        cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
+      }
+      if (!with_matrix) continue;
+      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV
+      for (unsigned j = 0; j < n; ++j) AgradN[j] = st.tangent.middleCols<3>(3 * comp[j]) * gradN[j];
+      for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = 0; j < n; ++j)
+          cell_K(i, j) += gradN[i].dot(AgradN[j].segment<3>(3 * comp[i])) * JxW;
+    }
+
+    // Tractions and contact on boundary faces.
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary()) continue;
+      const auto id = cell->face(f)->boundary_id();
+      Eigen::Vector3d traction_sum = Eigen::Vector3d::Zero();
+      const Eigen::Vector3d* traction = nullptr;
+      for (const auto& [group, t] : tractions)
+        if (in_group(id, group)) {
+          traction_sum += t;
+          traction = &traction_sum;
+        }
+      if (traction == nullptr && !tool) continue;
+      ffv.reinit(cell, f);
+      if (tool) ffv[disp].get_function_values(state, face_u);
+      for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
+        const double JxW = ffv.JxW(q);
+        Eigen::Vector3d t = Eigen::Vector3d::Zero();
+        if (traction != nullptr) {
+          t += load.load_factor * *traction;
+          out.traction_on_body += load.load_factor * *traction * JxW;
+        }
+        Eigen::Matrix3d dt_dx = Eigen::Matrix3d::Zero();
+        if (tool) {
+          const Eigen::Vector3d x = to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
+          const ToolContactPoint c = tool_contact(*tool, load.tool_position, x);
+          if (c.inside) {
+            // t_c = ε_N p n (per unit reference area), p = −g
+            const Eigen::Vector3d tc = penalty * c.penetration * c.normal;
+            t += tc;
+            out.contact_on_body += tc * JxW;
+            ++out.contact_points;
+            out.contact_area += JxW;
+            out.max_pressure = std::max(out.max_pressure, penalty * c.penetration);
+            // ∂t_c/∂x = ε_N (−n⊗n + p ∂n/∂x)
+            dt_dx = penalty * (-c.normal * c.normal.transpose() + c.penetration * c.normal_derivative);
+          }
+        }
+        for (unsigned i = 0; i < n; ++i) {
+          const double Ni = ffv.shape_value_component(i, q, comp[i]);
+          if (Ni == 0.0) continue;
+          cell_ext(i) += Ni * t[comp[i]] * JxW;
+          if (with_matrix && tool)
+            for (unsigned j = 0; j < n; ++j)
+              cell_K(i, j) -= Ni * dt_dx(comp[i], comp[j]) * ffv.shape_value_component(j, q, comp[j]) * JxW;
+        }
+      }
+    }
+    for (unsigned i = 0; i < n; ++i) {
+      f_int(local[i]) += cell_int(i);
+      f_ext(local[i]) += cell_ext(i);
+    }
+    if (with_matrix) {
+      for (unsigned i = 0; i < n; ++i) cell_rhs(i) = cell_ext(i) - cell_int(i);
+      constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
+    }
+  }
+  out.residual = f_int;
+  out.residual -= f_ext;
+  out.internal_norm = f_int.l2_norm();
+  out.external_norm = f_ext.l2_norm();
+  if (!std::isfinite(out.residual.l2_norm())) throw FiniteStrainError("finite strain: non-finite residual");
+}
+
+FiniteStrainSolver::FiniteStrainSolver(const FiniteStrainProblem& problem, const SolverSettings& settings)
+    : m_impl(std::make_unique<Impl>()) {
+  m_impl->settings = settings;
+  m_impl->build(problem);
+}
+
+FiniteStrainSolver::~FiniteStrainSolver() = default;
+
+EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
+  Impl& m = *m_impl;
+  EquilibriumReport report;
+  const dealii::Vector<double> start = m.u;
+  Impl::Assembly assembly;
+  dealii::Vector<double> rhs(m.dof.n_dofs()), du(m.dof.n_dofs());
+  auto fail = [&](std::string why) {
+    m.u = start;
+    report.converged = false;
+    report.failure = std::move(why);
+    return report;
+  };
+  try {
+    for (int it = 0;; ++it) {
+      // Constraints of this iteration: the remaining Dirichlet increment target − u.
+      dealii::AffineConstraints<double> constraints;
+      double mismatch = 0.0;
+      for (const auto& d : m.dirichlet) {
+        const double g = m.dirichlet_target(d, load.load_factor) - m.u[d.index];
+        mismatch = std::max(mismatch, std::abs(g));
+        constraints.add_line(d.index);
+        constraints.set_inhomogeneity(d.index, g);
+      }
+      constraints.close();
+      auto t0 = Clock::now();
+      m.assemble(m.u, load, true, assembly, &constraints, &rhs);
+      report.assembly_seconds += seconds_since(t0);
+      const double r = m.free_norm(assembly.residual);
+      report.residual_history.push_back(r);
+      const double scale = assembly.internal_norm + assembly.external_norm;
+      const double tol = m.settings.relative_tolerance * scale + m.settings.absolute_tolerance;
+      const double u_scale = std::max(m.u.linfty_norm(), 1e-300);
+      if (r <= tol && mismatch <= 1e-12 * u_scale + 1e-300) {
+        report.converged = true;
+        break;
+      }
+      if (it >= m.settings.max_newton_iterations)
+        return fail("no convergence in " + std::to_string(m.settings.max_newton_iterations) + " Newton iterations");
+      t0 = Clock::now();
+      report.linear_iterations += m.linear->solve(m.K, du, rhs);
+      report.linear_solve_seconds += seconds_since(t0);
+      constraints.distribute(du);
+      ++report.newton_iterations;
+      // Backtracking line search on the free residual: the first α in 1, ½, … (6 tries) that keeps
+      // every element valid and reduces |R|, else the valid α with the smallest |R|. While a
+      // Dirichlet increment is pending the residual is no merit function (it starts at zero and
+      // must grow with the imposed displacement): then the largest valid α is taken.
+      const dealii::Vector<double> base = m.u;
+      double best_alpha = 0.0, best_r = std::numeric_limits<double>::infinity();
+      Impl::Assembly trial;
+      for (double alpha = 1.0; alpha > 1.0 / 64.0; alpha *= 0.5) {
+        m.u = base;
+        m.u.add(alpha, du);
+        try {
+          t0 = Clock::now();
+          m.assemble(m.u, load, false, trial, nullptr, nullptr);
+          report.assembly_seconds += seconds_since(t0);
+        } catch (const FiniteStrainError&) {
+          continue;
+        }
+        const double rt = m.free_norm(trial.residual);
+        if (rt < best_r) {
+          best_r = rt;
+          best_alpha = alpha;
+        }
+        if (mismatch > 0.0 || rt <= (1.0 - 1e-4 * alpha) * r || rt <= tol) {
+          best_alpha = alpha;
+          break;
+        }
+      }
+      if (best_alpha == 0.0) return fail("every line-search step inverts an element");
+      m.u = base;
+      m.u.add(best_alpha, du);
+    }
+  } catch (const FiniteStrainError& e) {
+    return fail(e.what());
+  } catch (const std::runtime_error& e) {
+    return fail(std::string("linear solver: ") + e.what());
+  }
+  // Reactions: the residual on the Dirichlet DOFs is the force the supports put on the body.
+  Eigen::Vector3d support_on_body = Eigen::Vector3d::Zero();
+  for (const auto& d : m.dirichlet) support_on_body[d.component] += assembly.residual[d.index];
+  report.support_reaction = -support_on_body;
+  report.tool_force = -assembly.contact_on_body;
+  report.traction_resultant = assembly.traction_on_body;
+  report.contact_points = assembly.contact_points;
+  report.contact_area = assembly.contact_area;
+  report.max_contact_pressure = assembly.max_pressure;
+  return report;
+}
+
+std::size_t FiniteStrainSolver::dof_count() const { return m_impl->dof.n_dofs(); }
+std::size_t FiniteStrainSolver::cell_count() const { return m_impl->tria.n_active_cells(); }
+std::string FiniteStrainSolver::linear_solver_name() const { return m_impl->linear->name(); }
+double FiniteStrainSolver::contact_penalty() const { return m_impl->penalty; }
+double FiniteStrainSolver::max_displacement() const {
+  double best = 0.0;
+  const auto& u = m_impl->u;
+  for (std::size_t k = 0; k + 2 < u.size(); k += 3)
+    best = std::max(best, std::sqrt(u[k] * u[k] + u[k + 1] * u[k + 1] + u[k + 2] * u[k + 2]));
+  return best;
+}
+
+Eigen::Vector3d FiniteStrainSolver::displacement_at(const Eigen::Vector3d& X) const {
+  const Impl& m = *m_impl;
+  // The cell whose barycentric coordinates of X are all >= −tol (straight-sided tetrahedra).
+  for (const auto& cell : m.dof.active_cell_iterators()) {
+    Eigen::Matrix3d A;
+    const Eigen::Vector3d v0 = to_eigen(cell->vertex(0));
+    for (unsigned k = 1; k < 4; ++k) A.col(k - 1) = to_eigen(cell->vertex(k)) - v0;
+    const Eigen::Vector3d xi = A.lu().solve(X - v0);
+    const double tol = 1e-10;
+    if (xi.minCoeff() < -tol || xi.sum() > 1.0 + tol) continue;
+    // The unit tetrahedron's vertices 1, 2, 3 are e_x, e_y, e_z: the unit point is ξ itself.
+    const dealii::Quadrature<3> point(dealii::Point<3>(xi[0], xi[1], xi[2]));
+    dealii::FEValues<3> fv(*m.mapping, *m.fe, point, dealii::update_values);
+    fv.reinit(cell);
+    std::vector<dealii::Vector<double>> value(1, dealii::Vector<double>(3));
+    fv.get_function_values(m.u, value);
+    return {value[0][0], value[0][1], value[0][2]};
+  }
+  throw std::out_of_range("displacement_at: the point lies outside the mesh");
+}
+
+std::vector<Eigen::Matrix3d> FiniteStrainSolver::quadrature_cauchy_stresses() const {
+  const Impl& m = *m_impl;
+  std::vector<Eigen::Matrix3d> out;
+  dealii::FEValues<3> fv(*m.mapping, *m.fe, *m.cell_quadrature, dealii::update_gradients);
+  std::vector<dealii::Tensor<2, 3>> grads(m.cell_quadrature->size());
+  for (const auto& cell : m.dof.active_cell_iterators()) {
+    fv.reinit(cell);
+    fv[dealii::FEValuesExtractors::Vector(0)].get_function_gradients(m.u, grads);
+    for (const auto& g : grads) {
+      const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(g);
+      out.push_back(cauchy_stress(F, m.laws[cell->material_id()]->stress_and_tangent(F).first_piola));
+    }
+  }
+  return out;
+}
+
+std::vector<double> FiniteStrainSolver::state() const {
+  return std::vector<double>(m_impl->u.begin(), m_impl->u.end());
+}
+
+void FiniteStrainSolver::set_state(const std::vector<double>& values) {
+  if (values.size() != m_impl->u.size())
+    throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values for " +
+                                std::to_string(m_impl->u.size()) + " DOFs");
+  std::copy(values.begin(), values.end(), m_impl->u.begin());
+}
+
+namespace {
+
+// Pointwise J, von Mises and Cauchy stress components from the displacement gradient.
+class StressPostprocessor final : public dealii::DataPostprocessor<3> {
+public:
+  explicit StressPostprocessor(const std::vector<std::unique_ptr<HyperelasticLaw>>& laws) : m_laws(laws) {}
+  void evaluate_vector_field(const dealii::DataPostprocessorInputs::Vector<3>& in,
+                             std::vector<dealii::Vector<double>>& out) const override {
+    const auto cell = in.template get_cell<3>();
+    const HyperelasticLaw& law = *m_laws[cell->material_id()];
+    for (std::size_t q = 0; q < in.solution_gradients.size(); ++q) {
+      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+      for (unsigned c = 0; c < 3; ++c)
+        for (unsigned d = 0; d < 3; ++d) F(c, d) += in.solution_gradients[q][c][d];
+      const double J = F.determinant();
+      out[q] = 0.0;
+      out[q][0] = J;
+      if (!(J > 0.0)) continue;
+      const Eigen::Matrix3d sigma = cauchy_stress(F, law.stress_and_tangent(F).first_piola);
+      out[q][1] = von_mises(sigma);
+      const int idx[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {1, 2}, {0, 2}};
+      for (int k = 0; k < 6; ++k) out[q][2 + static_cast<unsigned>(k)] = sigma(idx[k][0], idx[k][1]);
+    }
+  }
+  std::vector<std::string> get_names() const override {
+    return {"J", "von_mises", "sigma_xx", "sigma_yy", "sigma_zz", "sigma_xy", "sigma_yz", "sigma_xz"};
+  }
+  dealii::UpdateFlags get_needed_update_flags() const override { return dealii::update_gradients; }
+
+private:
+  const std::vector<std::unique_ptr<HyperelasticLaw>>& m_laws;
+};
+
+} // namespace
+
+void FiniteStrainSolver::write_fields(const std::filesystem::path& vtu, const LoadState& load) const {
+  const Impl& m = *m_impl;
+  // Contact pressure per cell: the largest ε_N p over the cell's boundary quadrature points.
+  dealii::Vector<float> pressure(m.tria.n_active_cells()), material(m.tria.n_active_cells());
+  if (m.tool) {
+    dealii::FEFaceValues<3> ffv(*m.mapping, *m.fe, *m.face_quadrature,
+                                dealii::update_values | dealii::update_quadrature_points);
+    std::vector<dealii::Tensor<1, 3>> face_u(m.face_quadrature->size());
+    for (const auto& cell : m.dof.active_cell_iterators())
+      for (const unsigned f : cell->face_indices()) {
+        if (!cell->face(f)->at_boundary()) continue;
+        ffv.reinit(cell, f);
+        ffv[dealii::FEValuesExtractors::Vector(0)].get_function_values(m.u, face_u);
+        for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
+          const Eigen::Vector3d x =
+              to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
+          const ToolContactPoint c = tool_contact(*m.tool, load.tool_position, x);
+          if (c.inside)
+            pressure[cell->active_cell_index()] =
+                std::max(pressure[cell->active_cell_index()], static_cast<float>(m.penalty * c.penetration));
+        }
+      }
+  }
+  for (const auto& cell : m.tria.active_cell_iterators())
+    material[cell->active_cell_index()] = static_cast<float>(cell->material_id());
+  StressPostprocessor stress(m.laws);
+  dealii::DataOut<3> out;
+  out.attach_dof_handler(m.dof);
+  const std::vector<std::string> names(3, "displacement");
+  const std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> kinds(
+      3, dealii::DataComponentInterpretation::component_is_part_of_vector);
+  out.add_data_vector(m.u, names, dealii::DataOut<3>::type_dof_data, kinds);
+  out.add_data_vector(m.u, stress);
+  out.add_data_vector(pressure, "contact_pressure", dealii::DataOut<3>::type_cell_data);
+  out.add_data_vector(material, "material_id", dealii::DataOut<3>::type_cell_data);
+  // Quadratic output cells without write_higher_order_cells (dealii-on-debian12.md, "output").
+  out.build_patches(*m.mapping, static_cast<unsigned>(m.settings.degree));
+  std::ofstream file(vtu);
+  if (!file) throw std::runtime_error("write_fields: cannot open " + vtu.string());
+  out.write_vtu(file);
+}
+
+} // namespace kerf::reference

@@ -1,0 +1,167 @@
+#pragma once
+// FiniteStrainSolver: kerf's offline ground truth — quasi-static, total-Lagrangian finite-strain
+// elasticity on the scene's tetrahedra (FE_SimplexP of degree 1 or 2, QGaussSimplex, MappingFE;
+// deal.II 9.4), Newton–Raphson with a backtracking line search, Dirichlet supports, dead-load
+// tractions and a rigid tool in penalty contact. In the spirit of deal.II's step-44 and the code
+// gallery's "Quasi-Static Finite-Strain Compressible Elasticity", written for tetrahedra.
+//
+// This header is plain data + pimpl: it includes no deal.II or PETSc, so the rest of kerf compiles
+// without them (the only translation units that include deal.II are finite_strain_solver.cpp,
+// tangent_solver.cpp and field_output.cpp in this folder).
+
+#include "meshes/tet_mesh.hpp"
+#include "reference/rigid_tool.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kerf::reference {
+
+/// Which hyperelastic law a region uses (one class each in reference/material/).
+enum class LawKind {
+  neo_hookean,           ///< Bonet–Wood: ψ = μ/2 (I₁−3) − μ ln J + λ/2 (ln J)² (neo_hookean.hpp)
+  decoupled_neo_hookean, ///< deal.II code gallery: ψ = μ/2 (Ī₁−3) + κ/4 (J²−1−2 ln J)
+  st_venant_kirchhoff    ///< ψ = λ/2 (tr E)² + μ E:E
+};
+
+/// The material of one gmsh physical volume.
+struct MaterialRegion {
+  std::string volume_group = "body"; ///< TetMesh volume group name
+  LawKind law = LawKind::neo_hookean;
+  double youngs_modulus = 0.0; ///< E [Pa] > 0
+  double poisson_ratio = 0.0;  ///< ν in (-1, 0.5)
+};
+
+/// A displacement condition on a named TetMesh surface group.
+struct DisplacementBoundary {
+  enum class Kind {
+    bonded,    ///< u = 0 (all components)
+    sliding,   ///< u·n = 0 on a plane surface normal to a coordinate axis (n = ±e_k)
+    prescribed ///< u_k = g_k(X, load factor) for the components marked in `components`
+  };
+  std::string surface;
+  Kind kind = Kind::bonded;
+  /// prescribed: the displacement [m] at reference point X [m] and load factor in [0, 1].
+  std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double load)> displacement;
+  std::array<bool, 3> components{true, true, true}; ///< prescribed: which components are fixed
+};
+
+/// A dead-load traction: a uniform traction per unit reference area on a named surface whose
+/// resultant is `load factor × total_force` [N], direction fixed in space (as in the code gallery's
+/// Cook's membrane).
+struct TractionBoundary {
+  std::string surface;
+  Eigen::Vector3d total_force = Eigen::Vector3d::Zero(); ///< [N] at load factor 1
+};
+
+/// The boundary-value problem: mesh (metres), materials, supports, loads, tool.
+struct FiniteStrainProblem {
+  TetMesh mesh;
+  std::vector<MaterialRegion> materials; ///< first matching region wins; every tet needs one
+  std::vector<DisplacementBoundary> displacement_boundaries;
+  std::vector<TractionBoundary> tractions;
+  std::optional<RigidToolShape> tool;    ///< rigid tool in frictionless penalty contact
+};
+
+/// Linear solver for each Newton step.
+enum class LinearSolverChoice {
+  automatic, ///< direct up to SolverSettings::direct_dof_limit DOFs, iterative above
+  direct,    ///< UMFPACK (deal.II SparseDirectUMFPACK) on an optimised BLAS
+  iterative  ///< PETSc CG + GAMG with the rigid-body near null space; unpreconditioned-norm stop
+};
+
+/// Discretisation and solver settings (validated by the solver's constructor).
+struct SolverSettings {
+  int degree = 1;        ///< FE_SimplexP degree, 1 or 2
+  int refinements = 0;   ///< global refinements of the mesh (each splits a tetrahedron into 8)
+  LinearSolverChoice linear_solver = LinearSolverChoice::automatic;
+  std::size_t direct_dof_limit = 60000; ///< automatic: direct below this many DOFs
+  double relative_tolerance = 1e-9;     ///< Newton: |R_free| <= rel × (|f_int| + |f_ext|) + abs
+  double absolute_tolerance = 1e-12;    ///< [N]
+  int max_newton_iterations = 25;
+  double iterative_tolerance = 1e-10;   ///< CG: true (unpreconditioned) residual relative to |b|
+  /// Contact penalty ε_N [Pa/m]; 0 = automatic, 50 E_max / h_min (h_min the shortest edge after
+  /// refinement), i.e. a penetration of 2% of an element under a stress of E.
+  double contact_penalty = 0.0;
+};
+
+/// The load of one equilibrium solve.
+struct LoadState {
+  double load_factor = 0.0;                               ///< scales tractions and prescribed u
+  Eigen::Vector3d tool_position = Eigen::Vector3d::Zero(); ///< tool reference point [m]
+};
+
+/// What one equilibrium solve did and found.
+struct EquilibriumReport {
+  bool converged = false;
+  int newton_iterations = 0;
+  std::vector<double> residual_history; ///< |R_free| [N] before each Newton step
+  Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();       ///< contact resultant: body on tool [N]
+  Eigen::Vector3d support_reaction = Eigen::Vector3d::Zero(); ///< body on its supports [N]
+  Eigen::Vector3d traction_resultant = Eigen::Vector3d::Zero(); ///< applied tractions on the body [N]
+  int contact_points = 0;    ///< boundary quadrature points inside the tool
+  double contact_area = 0.0; ///< reference area of those points' weights [m^2]
+  double max_contact_pressure = 0.0; ///< [Pa]
+  double assembly_seconds = 0.0;
+  double linear_solve_seconds = 0.0;
+  int linear_iterations = 0; ///< iterative solver: total CG iterations
+  std::string failure;       ///< why it did not converge (empty if converged)
+};
+
+/// The finite-strain reference solver (see file comment). Holds the current displacement state;
+/// `solve` moves it to equilibrium under a new load, or leaves it unchanged on failure.
+class FiniteStrainSolver {
+public:
+  /// Builds the triangulation from `problem.mesh` (volume groups -> material_id, surface groups
+  /// -> boundary_id by name), the finite element space and the supports. Throws
+  /// std::invalid_argument naming the field on bad input (unknown group, a tet without material,
+  /// a sliding surface that is not axis-aligned, degree not 1 or 2).
+  FiniteStrainSolver(const FiniteStrainProblem& problem, const SolverSettings& settings);
+  ~FiniteStrainSolver();
+  FiniteStrainSolver(const FiniteStrainSolver&) = delete;
+  FiniteStrainSolver& operator=(const FiniteStrainSolver&) = delete;
+
+  /// Newton–Raphson from the current state to equilibrium under `load`. On success the state is
+  /// the new equilibrium; on failure (no convergence in max iterations, an inverted element, a
+  /// non-finite residual) the state is restored and report.converged is false.
+  EquilibriumReport solve(const LoadState& load);
+
+  [[nodiscard]] std::size_t dof_count() const;
+  [[nodiscard]] std::size_t cell_count() const;
+  /// "umfpack" or "petsc-cg-gamg": what `solve` uses for this problem size and settings.
+  [[nodiscard]] std::string linear_solver_name() const;
+  /// The contact penalty in use [Pa/m].
+  [[nodiscard]] double contact_penalty() const;
+
+  /// Displacement [m] at reference point X (evaluated in the tetrahedron containing X). Throws
+  /// std::out_of_range if X lies outside the mesh.
+  [[nodiscard]] Eigen::Vector3d displacement_at(const Eigen::Vector3d& X) const;
+  /// Cauchy stress [Pa] at every cell quadrature point of the current state.
+  [[nodiscard]] std::vector<Eigen::Matrix3d> quadrature_cauchy_stresses() const;
+  /// Largest displacement magnitude over the DOFs [m].
+  [[nodiscard]] double max_displacement() const;
+
+  /// The state for a checkpoint: the DOF values of the displacement.
+  [[nodiscard]] std::vector<double> state() const;
+  /// Restores a checkpointed state. Throws std::invalid_argument on a size mismatch.
+  void set_state(const std::vector<double>& values);
+
+  /// Writes the current fields to `vtu` (displacement; J, Cauchy stress, von Mises per point;
+  /// contact pressure and material id per cell) with the tool at `load.tool_position`.
+  void write_fields(const std::filesystem::path& vtu, const LoadState& load) const;
+
+  struct Impl;
+
+private:
+  std::unique_ptr<Impl> m_impl;
+};
+
+} // namespace kerf::reference

@@ -1,0 +1,67 @@
+#include "reference/rigid_tool.hpp"
+
+#include <Eigen/Geometry>
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace kerf::reference {
+
+void validate(const RigidToolShape& s) {
+  if (s.kind == RigidToolShape::Kind::sphere) {
+    if (!(s.radius > 0.0) || !std::isfinite(s.radius))
+      throw std::invalid_argument("rigid tool: sphere radius must be positive, got " + std::to_string(s.radius));
+    return;
+  }
+  if (std::abs(s.edge_direction.norm() - 1.0) > 1e-9 || std::abs(s.cutting_direction.norm() - 1.0) > 1e-9)
+    throw std::invalid_argument("rigid tool: wedge edge_direction and cutting_direction must be unit vectors");
+  if (std::abs(s.edge_direction.dot(s.cutting_direction)) > 1e-9)
+    throw std::invalid_argument("rigid tool: wedge cutting_direction must be orthogonal to edge_direction");
+  if (!(s.wedge_angle > 0.0 && s.wedge_angle < std::numbers::pi))
+    throw std::invalid_argument("rigid tool: wedge_angle must lie in (0, pi), got " + std::to_string(s.wedge_angle));
+  if (!(s.thickness > 0.0) || !std::isfinite(s.thickness))
+    throw std::invalid_argument("rigid tool: wedge thickness must be positive, got " + std::to_string(s.thickness));
+}
+
+ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c, const Eigen::Vector3d& x) {
+  ToolContactPoint out;
+  const Eigen::Vector3d r = x - c;
+  if (s.kind == RigidToolShape::Kind::sphere) {
+    const double dist = r.norm();
+    // g = |x − c| − R; a point at the centre has no defined normal: it cannot occur in a converged
+    // state (the penalty grows without bound) and is left out.
+    if (dist >= s.radius || dist < 1e-12 * s.radius) return out;
+    out.inside = true;
+    out.penetration = s.radius - dist;
+    out.normal = r / dist;
+    // ∂n/∂x = (I − n⊗n) / |x − c|
+    out.normal_derivative = (Eigen::Matrix3d::Identity() - out.normal * out.normal.transpose()) / dist;
+    return out;
+  }
+  const Eigen::Vector3d& d = s.cutting_direction;
+  const Eigen::Vector3d m = s.edge_direction.cross(d);
+  const double phi = 0.5 * s.wedge_angle;
+  const std::array<Eigen::Vector3d, 4> normals{std::sin(phi) * d + std::cos(phi) * m,
+                                               std::sin(phi) * d - std::cos(phi) * m, m, -m};
+  const std::array<double, 4> offsets{0.0, 0.0, 0.5 * s.thickness, 0.5 * s.thickness};
+  int face = -1;
+  double largest = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < 4; ++k) {
+    const double sk = r.dot(normals[k]) - offsets[k];
+    if (sk > largest) {
+      largest = sk;
+      face = k;
+    }
+  }
+  if (largest >= 0.0) return out;
+  out.inside = true;
+  out.penetration = -largest;
+  out.normal = normals[face];
+  return out;
+}
+
+} // namespace kerf::reference

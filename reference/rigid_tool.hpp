@@ -1,0 +1,45 @@
+#pragma once
+// Rigid tools of the reference: the scene's sphere (stylus tip) and blade (a wedge with its edge
+// and two flanks, closed by a slab of the blade's thickness), as signed-distance functions for
+// penalty contact (Wriggers 2006, "Computational Contact Mechanics", §5.2, §6.3): a body point
+// x inside the tool has penetration p = −g > 0 and is pushed out along the tool's outward normal n
+// by the traction t = ε_N p n (per unit reference area).
+
+#include <Eigen/Core>
+
+namespace kerf::reference {
+
+/// The geometry of a rigid tool relative to its reference point (the sphere's centre or the
+/// blade edge's midpoint). Units: metres, radians.
+struct RigidToolShape {
+  enum class Kind { sphere, wedge };
+  Kind kind = Kind::sphere;
+  double radius = 0.0; ///< sphere radius [m] > 0
+  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();     ///< wedge: unit edge direction e
+  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ(); ///< wedge: unit d ⟂ e, edge advances along d
+  double wedge_angle = 0.0; ///< wedge: included angle θ [rad] in (0, π)
+  double thickness = 0.0;   ///< wedge: back thickness t [m] > 0 (the slab behind the flanks)
+};
+
+/// Throws std::invalid_argument naming the field if the shape is not usable (non-positive size,
+/// non-unit or non-orthogonal directions, angle out of range).
+void validate(const RigidToolShape& shape);
+
+/// Closest-exit contact of one point against the tool placed at `position`.
+struct ToolContactPoint {
+  bool inside = false;        ///< x lies inside the tool (penetration > 0)
+  double penetration = 0.0;   ///< p = −g >= 0 [m]
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();    ///< outward unit normal n of the tool surface
+  Eigen::Matrix3d normal_derivative = Eigen::Matrix3d::Zero(); ///< ∂n/∂x [1/m] (sphere: (I − n⊗n)/r; planes: 0)
+};
+
+/// Where x is relative to the tool at `position`.
+/// Sphere: g = |x − c| − R, n = (x − c)/|x − c|.
+/// Wedge: in the frame (d, m = e × d), the solid is the intersection of the half-spaces
+///   s₁ = (x−c)·(sin φ d + cos φ m) <= 0,  s₂ = (x−c)·(sin φ d − cos φ m) <= 0 (the flanks, φ = θ/2),
+///   s₃ = (x−c)·m − t/2 <= 0,               s₄ = −(x−c)·m − t/2 <= 0 (the back slab),
+/// infinite along e and behind the edge; the penetration is −max sₖ and n the normal of the face
+/// attaining it (the nearest exit).
+ToolContactPoint tool_contact(const RigidToolShape& shape, const Eigen::Vector3d& position, const Eigen::Vector3d& x);
+
+} // namespace kerf::reference

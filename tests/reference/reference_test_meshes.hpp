@@ -1,0 +1,28 @@
+#pragma once
+// Meshes of the reference verification tests, built without gmsh: a box with its six faces
+// named, the MacNeal–Harder 3-D patch, and Cook's membrane.
+
+#include "meshes/tet_mesh.hpp"
+
+namespace kerf::reference::test {
+
+/// box_tet_mesh with its surface groups replaced by the six faces `xmin`, `xmax`, `ymin`,
+/// `ymax`, `zmin`, `zmax`, plus `boundary` (all boundary triangles).
+TetMesh named_box(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper, int nx, int ny, int nz);
+
+/// Names the boundary of `mesh` by the bounding-box face each triangle lies on (as named_box).
+void name_bounding_faces(TetMesh& mesh);
+
+/// MacNeal & Harder (1985), "A proposed standard set of problems to test finite element
+/// accuracy", Finite Elem. Anal. Des. 1, 3–20, Fig. 2: the unit cube cut into seven hexahedra by
+/// eight interior nodes; each hexahedron split into 24 tetrahedra through its face and body
+/// centres. Surface group `boundary`.
+TetMesh macneal_harder_patch();
+
+/// Cook's membrane as in the deal.II code gallery's "Quasi-Static Finite-Strain Compressible
+/// Elasticity" (cook_membrane.cc, make_grid): the trapezoid (0,0), (48,44), (48,60), (0,44) mm,
+/// 1 mm thick (z in [-0.5, 0.5] mm), n by n by 1 cells, each split into 6 tetrahedra. Surface
+/// groups `xmin` (clamped), `xmax` (loaded), `zmin`, `zmax`. Units: metres.
+TetMesh cook_membrane(int n);
+
+} // namespace kerf::reference::test

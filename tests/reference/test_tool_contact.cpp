@@ -1,0 +1,65 @@
+// Rigid-tool penalty contact: the tool geometry against hand-computed distances, and the
+// equilibrium of a block pressed by the sphere — the contact resultant on the tool equals minus
+// the support reaction (global force balance, Newton's third law; no other load acts).
+
+#include "reference/finite_strain_solver.hpp"
+#include "reference/rigid_tool.hpp"
+#include "tests/reference/reference_test_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+namespace kerf::reference {
+namespace {
+
+TEST(RigidTool, SpherePenetrationAndNormal) {
+  RigidToolShape s;
+  s.radius = 2e-3;
+  const ToolContactPoint c = tool_contact(s, Eigen::Vector3d(0, 0, 2.5e-3), Eigen::Vector3d(0, 0, 1e-3));
+  ASSERT_TRUE(c.inside);
+  EXPECT_NEAR(c.penetration, 0.5e-3, 1e-15); // R − |x − c| = 2 − 1.5 mm
+  EXPECT_NEAR((c.normal - Eigen::Vector3d(0, 0, -1)).norm(), 0.0, 1e-15);
+  EXPECT_FALSE(tool_contact(s, Eigen::Vector3d(0, 0, 2.5e-3), Eigen::Vector3d(0, 0, 0.4e-3)).inside);
+}
+
+TEST(RigidTool, WedgeNearestExit) {
+  RigidToolShape w;
+  w.kind = RigidToolShape::Kind::wedge;
+  w.wedge_angle = std::numbers::pi / 2.0; // 90°: flanks at 45°
+  w.thickness = 10e-3;
+  // Edge along y at the origin cutting down (−z): a point 1 mm above the edge on its axis is
+  // inside, nearest exit through a flank at distance 1 mm · sin 45°.
+  const ToolContactPoint c = tool_contact(w, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1e-3));
+  ASSERT_TRUE(c.inside);
+  EXPECT_NEAR(c.penetration, 1e-3 * std::sin(std::numbers::pi / 4.0), 1e-15);
+  EXPECT_NEAR(std::abs(c.normal.z()), std::sin(std::numbers::pi / 4.0), 1e-12);
+  // Ahead of the edge (below it) is outside.
+  EXPECT_FALSE(tool_contact(w, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -1e-4)).inside);
+  RigidToolShape bad = w;
+  bad.wedge_angle = 0.0;
+  EXPECT_THROW(validate(bad), std::invalid_argument);
+}
+
+TEST(ToolContact, ContactResultantBalancesTheSupportReaction) {
+  const double L = 0.02, R = 4e-3;
+  FiniteStrainProblem p;
+  p.mesh = test::named_box(Eigen::Vector3d(-L / 2, -L / 2, 0), Eigen::Vector3d(L / 2, L / 2, L / 2), 4, 4, 2);
+  p.materials.push_back({"body", LawKind::neo_hookean, 1e5, 0.3});
+  p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::bonded, {}, {}});
+  RigidToolShape sphere;
+  sphere.radius = R;
+  p.tool = sphere;
+  FiniteStrainSolver solver(p, SolverSettings{});
+  for (double depth : {0.2e-3, 0.4e-3}) {
+    const EquilibriumReport r = solver.solve({0.0, Eigen::Vector3d(0, 0, L / 2 + R - depth)});
+    ASSERT_TRUE(r.converged) << r.failure;
+    EXPECT_GT(r.contact_points, 0);
+    EXPECT_GT(r.tool_force.z(), 0.0); // the body pushes the tool back up
+    EXPECT_LT((r.tool_force + r.support_reaction).norm(), 1e-8 * r.tool_force.norm());
+  }
+}
+
+} // namespace
+} // namespace kerf::reference
