@@ -1,6 +1,7 @@
 // kerf haptic SCENE --model M --device ADDRESS [--device ADDRESS] [--rate HZ] [--record FILE] ...:
 // the live rig (realtime/haptics, docs/haptic-rig.md). One device per tool of the scene, in
-// scene order; SIGINT/SIGTERM (or a device's e-stop button) is an emergency stop.
+// scene order; SIGINT/SIGTERM (or a device's e-stop button) is an emergency stop. Optionally
+// through Colgate's virtual coupling (--coupling-stiffness, --coupling-damping, --virtual-mass).
 
 #include "experiments/cli/commands.hpp"
 #include "experiments/run/model_catalogue.hpp"
@@ -30,6 +31,7 @@ struct HapticOptions {
   double force_rate = 1000.0;
   double ramp = 0.2;
   double watchdog = 0.05;
+  VirtualCoupling coupling;
   bool no_realtime = false;
 };
 
@@ -71,6 +73,7 @@ void run_haptic(const HapticOptions& o) {
   settings.model_rate = o.model_rate;
   settings.duration = o.duration;
   settings.safety = {o.max_force, o.force_rate, o.ramp, o.watchdog};
+  settings.coupling = o.coupling;
   settings.realtime = !o.no_realtime;
   settings.on_realtime = [&o](const RealtimeSetup& r) {
     if (o.no_realtime) std::fprintf(stderr, "kerf haptic: real-time scheduling not requested (--no-realtime)\n");
@@ -152,6 +155,12 @@ void add_haptic_command(CLI::App& app) {
   c->add_option("--force-rate", o->force_rate, "force-rate limit [N/s]")->capture_default_str();
   c->add_option("--ramp", o->ramp, "ramp in/out time [s]")->capture_default_str();
   c->add_option("--watchdog", o->watchdog, "zero force after this much link silence [s]")->capture_default_str();
+  c->add_option("--coupling-stiffness", o->coupling.stiffness,
+                "render through Colgate's virtual coupling of this stiffness [N/m]; 0 = the model's force directly")
+      ->capture_default_str();
+  c->add_option("--coupling-damping", o->coupling.damping, "virtual coupling damping [N s/m]")->capture_default_str();
+  c->add_option("--virtual-mass", o->coupling.virtual_mass, "virtual tool mass of the coupling [kg]")
+      ->capture_default_str();
   c->add_flag("--no-realtime", o->no_realtime, "do not ask for SCHED_FIFO and locked memory");
   c->callback([o] { run_haptic(*o); });
 }

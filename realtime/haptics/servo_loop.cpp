@@ -82,6 +82,12 @@ ServoLoop::ServoLoop(ToolModel& model, std::span<HapticDevice* const> devices, c
     throw std::invalid_argument("servo loop: model " + std::string(model.name()) + " takes " +
                                 std::to_string(model.tool_count()) + " tool(s) but " + std::to_string(m_count) +
                                 " device(s) were given (device i drives tool i)");
+  const VirtualCoupling& c = settings.coupling;
+  if (!(c.stiffness >= 0.0) || !std::isfinite(c.stiffness) ||
+      (c.stiffness > 0.0 && (!(c.damping >= 0.0) || !std::isfinite(c.damping) || !(c.virtual_mass > 0.0) ||
+                             !std::isfinite(c.virtual_mass))))
+    throw std::invalid_argument("servo loop: virtual coupling needs stiffness >= 0, and when > 0 damping >= 0 and a "
+                                "positive virtual mass");
   m_period = 1.0 / settings.rate;
   for (std::size_t i = 0; i < m_count; ++i) m_safety.emplace_back(settings.safety);
   m_tools.resize(m_count);
@@ -89,6 +95,10 @@ ServoLoop::ServoLoop(ToolModel& model, std::span<HapticDevice* const> devices, c
   m_previous_position.assign(m_count, Eigen::Vector3d::Zero());
   m_previous_force.assign(m_count, Eigen::Vector3d::Zero());
   m_injected.assign(m_count, 0.0);
+  m_virtual_position.assign(m_count, Eigen::Vector3d::Zero());
+  m_virtual_velocity.assign(m_count, Eigen::Vector3d::Zero());
+  m_device_tools.resize(m_count);
+  m_desired.assign(m_count, Eigen::Vector3d::Zero());
   m_record.tools = static_cast<int>(m_count);
   m_model.reset();
 }
@@ -140,6 +150,18 @@ bool ServoLoop::tick(double now, double late) noexcept {
     m_tools[i].position = x;
     m_tools[i].time = static_cast<double>(k) * m_period;
   }
+  const bool coupled = m_settings.coupling.stiffness > 0.0;
+  if (coupled) { // the model is given the virtual tool, which starts where the device is
+    for (std::size_t i = 0; i < m_count; ++i) {
+      m_device_tools[i] = m_tools[i];
+      if (first) {
+        m_virtual_position[i] = m_tools[i].position;
+        m_virtual_velocity[i].setZero();
+      }
+      m_tools[i].position = m_virtual_position[i];
+      m_tools[i].velocity = m_virtual_velocity[i];
+    }
+  }
 
   // 3. The model: stepped here, or its thread's output interpolated.
   double compute = 0.0;
@@ -172,6 +194,30 @@ bool ServoLoop::tick(double now, double late) noexcept {
     compute = b.compute;
   }
 
+  // Rendering: the model's force directly, or through the virtual coupling (VirtualCoupling).
+  for (std::size_t i = 0; i < m_count; ++i) {
+    if (!coupled) {
+      m_desired[i] = m_forces[i].force;
+      continue;
+    }
+    const VirtualCoupling& c = m_settings.coupling;
+    const Eigen::Vector3d& x_d = m_device_tools[i].position;
+    const Eigen::Vector3d& v_d = m_device_tools[i].velocity;
+    Eigen::Vector3d& x_v = m_virtual_position[i];
+    Eigen::Vector3d& v_v = m_virtual_velocity[i];
+    // A non-finite model force must not poison the virtual tool: it then feels the coupling only
+    // (and the safety layer still sees the model's NaN through the coupling force below).
+    const Eigen::Vector3d f_m = m_forces[i].force.allFinite() ? m_forces[i].force : Eigen::Vector3d::Zero();
+    // v+ (m_v/T + b_c + k_c T) = m_v v / T + F_m - k_c (x_v - x_d) + b_c v_d
+    const double T = m_period;
+    v_v = (c.virtual_mass / T * v_v + f_m - c.stiffness * (x_v - x_d) + c.damping * v_d) /
+          (c.virtual_mass / T + c.damping + c.stiffness * T);
+    x_v += T * v_v;
+    // F_d = k_c (x_v+ - x_d) + b_c (v+ - v_d)
+    m_desired[i] = c.stiffness * (x_v - x_d) + c.damping * (v_v - v_d);
+    if (!m_forces[i].force.allFinite()) m_desired[i] = m_forces[i].force;
+  }
+
   // 4. Safety, command, passivity observer, record.
   m_record.t = static_cast<double>(k) * m_period;
   m_record.compute = compute;
@@ -186,7 +232,7 @@ bool ServoLoop::tick(double now, double late) noexcept {
     const double link_age = now - state.received_time;
     std::uint32_t status = 0;
     const Eigen::Vector3d force =
-        m_safety[i].filter(m_forces[i].force, now, link_age, elapsed, state.max_force, status);
+        m_safety[i].filter(m_desired[i], now, link_age, elapsed, state.max_force, status);
     d.command(force, Eigen::Vector3d::Zero(), status, now);
     // Passivity observer (Hannaford & Ryu 2002, sampled): the force commanded at tick k-1 acts
     // while the device moves from x_{k-1} to x_k, so the energy the rig injects into the hand is

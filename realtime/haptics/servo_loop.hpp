@@ -23,12 +23,27 @@
 
 namespace kerf {
 
+/// Colgate's virtual coupling (Colgate, Stanley & Brown, IROS 1995; Adams & Hannaford, IEEE
+/// TRA 1999): the model's tool is a virtual tool of mass m_v joined to the device by a spring
+/// k_c and damper b_c, so the device never renders a stiffness above k_c whatever the model
+/// does. Per tick (T), with the model force F_m on the virtual tool at x_v and the device at
+/// (x_d, v_d), the virtual tool moves semi-implicitly in the coupling:
+///   m_v (v+ - v) / T = F_m - k_c (x_v+ - x_d) - b_c (v+ - v_d),  x_v+ = x_v + T v+,
+/// and the device is commanded the coupling force F_d = k_c (x_v+ - x_d) + b_c (v+ - v_d).
+/// The model force enters explicitly: stable for model stiffness k_m up to ~4 m_v / T^2.
+struct VirtualCoupling {
+  double stiffness = 0.0;     ///< k_c [N/m]; 0 = no coupling (the model's force is rendered directly)
+  double damping = 0.0;       ///< b_c [N s/m] >= 0
+  double virtual_mass = 0.0;  ///< m_v [kg] > 0 when the coupling is on
+};
+
 /// Settings of one session.
 struct ServoSettings {
   double rate = 1000.0;       ///< servo (device) rate [Hz], 100 to 10000
   double model_rate = 0.0;    ///< 0: the model steps in the servo thread; else its own thread at this rate [Hz] < rate
   double duration = 0.0;      ///< [s] from the start of the loop until the ramp out begins; 0: until stopped
   SafetyLimits safety;        ///< applied to every device
+  VirtualCoupling coupling;   ///< off unless coupling.stiffness > 0
   bool realtime = true;       ///< try SCHED_FIFO and mlockall (falls back with a warning)
   int priority = 80;          ///< SCHED_FIFO priority of the servo thread (the model thread gets one less)
   /// Called once from the servo thread, before its first tick, with what real-time setup it got
@@ -107,6 +122,10 @@ private:
   std::vector<Eigen::Vector3d> m_previous_position;
   std::vector<Eigen::Vector3d> m_previous_force;
   std::vector<double> m_injected;
+  std::vector<Eigen::Vector3d> m_virtual_position; ///< coupling: virtual tool x_v [m]
+  std::vector<Eigen::Vector3d> m_virtual_velocity; ///< coupling: virtual tool v_v [m/s]
+  std::vector<ToolState> m_device_tools;          ///< coupling: the devices' own states
+  std::vector<Eigen::Vector3d> m_desired;         ///< force handed to the safety layer [N]
   TimingStatistics m_timing;
   TimingStatistics m_model_timing;
   TickRecord m_record;

@@ -58,3 +58,30 @@ TEST(ReplayDevice, RefusesBadFilesAndAddresses) {
   EXPECT_THROW(open_device("udp://127.0.0.1"), std::invalid_argument);
   EXPECT_THROW(open_device("udp://127.0.0.1:99999"), std::invalid_argument);
 }
+
+TEST(VirtualCoupling, RendersTheSeriesSpringOfModelAndCoupling) {
+  // A still device at x_d = 0, a model spring k_m = 4000 N/m to r = 5 mm along z, a coupling
+  // k_c = 1000 N/m, b_c = 20 N s/m, m_v = 0.05 kg. At rest the virtual tool sits where the two
+  // springs balance, x_v = k_m r / (k_m + k_c) = 4 mm, and the device feels the series spring:
+  // F = k_m k_c / (k_m + k_c) r = 800 N/m x 5 mm = 4 N (plain rendering: k_m r = 20 N).
+  const auto file = std::filesystem::temp_directory_path() / ("kerf_still_" + std::to_string(getpid()) + ".csv");
+  std::ofstream(file) << "t,px,py,pz\n0,0,0,0\n100,0,0,0\n";
+  const Eigen::Vector3d r(0.0, 0.0, 0.005);
+  for (const bool coupled : {true, false}) {
+    auto device = open_device("replay:" + file.string());
+    test::RestPointSpring model(4000.0, {r, r}, 1);
+    HapticDevice* devices[] = {device.get()};
+    ServoSettings settings;
+    settings.safety = {1e6, 1e12, 1e-9, 1.0};
+    settings.realtime = false;
+    if (coupled) settings.coupling = {1000.0, 20.0, 0.05};
+    ServoLoop loop(model, devices, settings, nullptr);
+    for (int tick = 0; tick <= 3000; ++tick) ASSERT_TRUE(loop.tick(1e-3 * tick, 0.0));
+    const auto* replay = dynamic_cast<const ReplayDevice*>(device.get());
+    ASSERT_NE(replay, nullptr);
+    // The virtual tool's transient (omega = 316 rad/s, zeta = 0.63) has died out after 3 s.
+    EXPECT_NEAR(replay->last_force().z(), coupled ? 4.0 : 20.0, 1e-9);
+    EXPECT_NEAR(replay->last_force().head<2>().norm(), 0.0, 1e-12);
+  }
+  std::filesystem::remove(file);
+}

@@ -392,3 +392,34 @@ TEST(LoopbackSession, ModelInItsOwnThreadIsInterpolatedAtTheDeviceRate) {
   }
   EXPECT_GT(checked, 500);
 }
+
+TEST(LoopbackSession, VirtualCouplingKeepsTheRigPassiveWherePlainRenderingIsNot) {
+  // A stiff spring, k_m = 1e6 N/m, to the hand's start point; the hand (m = 0.2 kg, k = 800 N/m,
+  // b = 17.7 N s/m) pushes 1 mm into it over 1 s. Colgate & Schenkel (1997): a sampled spring is
+  // passive for b > K T / 2; 17.7 > 1e6 x 1e-3 / 2 = 500 fails for the plain rendering, while
+  // through a coupling of k_c = 2000 N/m, b_c = 5 N s/m the device sees at most 2000 N/m
+  // (17.7 > 1 + 5). The virtual tool's mass m_v = 0.5 kg keeps its explicit model force stable
+  // (k_m T^2 / m_v = 2 < 4). The passivity observer must show energy injected by the plain
+  // rendering and none (<= 0) through the coupling. Clamp and rate limit are opened up (50 N,
+  // 1e5 N/s) so that they do not mask the rendering.
+  std::array<double, 2> injected{};
+  for (const bool coupled : {false, true}) {
+    const Eigen::Vector3d start(0.0, 0.0, 0.0);
+    test::RestPointSpring model(1e6, {start, start}, 1);
+    EmulatedDeviceSettings device;
+    device.max_force = 50.0;
+    for (int k = 0; k <= 1000; ++k) device.target.emplace_back(0.0, 0.0, 1e-6 * k);
+    device.hold = 0.2;
+    ServoSettings servo;
+    servo.duration = 1.6;
+    servo.safety = {50.0, 1e5, 0.1, 0.05};
+    servo.realtime = false;
+    if (coupled) servo.coupling = {2000.0, 5.0, 0.5};
+    const LiveSession live = run_live(model, {device}, servo, session_file(coupled ? "coupled.csv" : "plain.csv"),
+                                      {"stylus"});
+    injected[coupled ? 1 : 0] = live.report.injected_energy.front();
+  }
+  std::printf("injected energy: plain %.6g J, coupled %.6g J\n", injected[0], injected[1]);
+  EXPECT_GT(injected[0], 0.0);
+  EXPECT_LE(injected[1], 0.0);
+}
