@@ -39,7 +39,7 @@ TetMesh box_tet_mesh(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper,
             v[static_cast<std::size_t>(s)] = node(i + (corner & 1), j + ((corner >> 1) & 1), k + ((corner >> 2) & 1));
           }
           // Odd permutations give negative orientation: swap two vertices.
-          const bool odd = (axes[0] > axes[1]) + (axes[0] > axes[2]) + (axes[1] > axes[2]);
+          const int odd = (axes[0] > axes[1]) + (axes[0] > axes[2]) + (axes[1] > axes[2]);
           if (odd % 2 != 0) std::swap(v[2], v[3]);
           mesh.tets.row(t++) << v[0], v[1], v[2], v[3];
         }
