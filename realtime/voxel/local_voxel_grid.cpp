@@ -7,6 +7,13 @@
 
 namespace kerf {
 
+namespace {
+/// floor(x) as an int, clamped far outside any grid so the conversion is always defined.
+int floor_index(double x) { return static_cast<int>(std::clamp(std::floor(x), -1e9, 1e9)); }
+} // namespace
+
+int LocalVoxelGrid::cell_index(double x) const { return floor_index(x / m_h); }
+
 LocalVoxelGrid::LocalVoxelGrid(std::array<int, 3> cells, double cell_size, int triangle_capacity)
     : m_cells(cells), m_h(cell_size), m_triangle_capacity(triangle_capacity) {
   for (int k = 0; k < 3; ++k)
@@ -100,10 +107,10 @@ bool LocalVoxelGrid::place(const VoxelFrame& frame, int column_u, int column_v, 
     const bool exit = world_normal.dot(frame.depth_axis) > 0.0;
     const double pa_lo = std::min({p[0].y(), p[1].y(), p[2].y()}), pa_hi = std::max({p[0].y(), p[1].y(), p[2].y()});
     const double pb_lo = std::min({p[0].z(), p[1].z(), p[2].z()}), pb_hi = std::max({p[0].z(), p[1].z(), p[2].z()});
-    const int i0 = std::max(0, static_cast<int>(std::floor(pa_lo / m_h - 0.5)) - column_u);
-    const int i1 = std::min(m_cells[1] - 1, static_cast<int>(std::floor(pa_hi / m_h - 0.5)) + 1 - column_u);
-    const int j0 = std::max(0, static_cast<int>(std::floor(pb_lo / m_h - 0.5)) - column_v);
-    const int j1 = std::min(m_cells[2] - 1, static_cast<int>(std::floor(pb_hi / m_h - 0.5)) + 1 - column_v);
+    const int i0 = std::max(0, floor_index(pa_lo / m_h - 0.5) - column_u);
+    const int i1 = std::min(m_cells[1] - 1, floor_index(pa_hi / m_h - 0.5) + 1 - column_u);
+    const int j0 = std::max(0, floor_index(pb_lo / m_h - 0.5) - column_v);
+    const int j1 = std::min(m_cells[2] - 1, floor_index(pb_hi / m_h - 0.5) + 1 - column_v);
     for (int i = i0; i <= i1; ++i) {
       const double a = (column_u + i + 0.5) * m_h;
       for (int j = j0; j <= j1; ++j) {

@@ -64,12 +64,19 @@ public:
   bool place(const VoxelFrame& frame, int column_u, int column_v, int layer_top, const Eigen::MatrixXd& vertices,
              const Eigen::MatrixXi& triangles, const AabbTree& tree, double slack, bool keep_overlap) noexcept;
 
+  /// The frame of the last placement.
   [[nodiscard]] const VoxelFrame& frame() const { return m_frame; }
+  /// Edge of a cell = the advance length [m].
   [[nodiscard]] double cell_size() const { return m_h; }
+  /// Cell counts along the depth axis, u and v.
   [[nodiscard]] int depth_cells() const { return m_cells[0]; }
   [[nodiscard]] int u_cells() const { return m_cells[1]; }
   [[nodiscard]] int v_cells() const { return m_cells[2]; }
+  /// True once `place` has run.
   [[nodiscard]] bool placed() const { return m_placed; }
+  /// Global cell index floor(x / h) of a local coordinate x [m], clamped to ±1e9 (defined for
+  /// any input).
+  [[nodiscard]] int cell_index(double x) const;
   /// First global column along u and v, first depth layer.
   [[nodiscard]] int column_u() const { return m_column_u; }
   [[nodiscard]] int column_v() const { return m_column_v; }

@@ -72,10 +72,9 @@ void VoxelSurfaceCuttingModel::reset() {
 }
 
 void VoxelSurfaceCuttingModel::place_grid_around(const Eigen::Vector3d& tip_local, bool keep_overlap) noexcept {
-  const double h = m_setup.advance_length;
-  const int column_u = static_cast<int>(std::floor(tip_local.y() / h)) - m_grid.u_cells() / 2;
-  const int column_v = static_cast<int>(std::floor(tip_local.z() / h)) - m_grid.v_cells() / 2;
-  const int layer_top = static_cast<int>(std::floor(tip_local.x() / h)) - m_grid.depth_cells() / 2;
+  const int column_u = m_grid.cell_index(tip_local.y()) - m_grid.u_cells() / 2;
+  const int column_v = m_grid.cell_index(tip_local.z()) - m_grid.v_cells() / 2;
+  const int layer_top = m_grid.cell_index(tip_local.x()) - m_grid.depth_cells() / 2;
   m_grid_incomplete = !m_grid.place(m_frame, column_u, column_v, layer_top, m_vertices,
                                     m_query.surface().triangles, m_tree, m_slack, keep_overlap);
 }
@@ -135,7 +134,7 @@ void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*d
   // Keep the tip well inside the grid: re-centre (keeping the overlap) near its border.
   {
     const int margin_lateral = std::max(1, std::min(m_grid.u_cells(), m_grid.v_cells()) / 4);
-    const int layer = static_cast<int>(std::floor(tip.x() / h)) - m_grid.layer_top();
+    const int layer = m_grid.cell_index(tip.x()) - m_grid.layer_top();
     int i = 0, j = 0;
     const bool inside = m_grid.column_at(tip.y(), tip.z(), i, j);
     const bool lateral_ok = inside && i >= margin_lateral && i < m_grid.u_cells() - margin_lateral &&
