@@ -22,6 +22,7 @@ struct RunOptions {
   std::string scene;
   std::string model;
   std::string out;
+  std::string integrator; ///< forwarded to the model as option "integrator"
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
 };
 
@@ -82,7 +83,9 @@ void run_run(const RunOptions& o) {
 
   const auto begin = std::chrono::steady_clock::now();
   const TetMesh mesh = scene_mesh(scene);
-  BuiltModel built = make_model(o.model, scene, mesh);
+  ModelOptions options;
+  if (!o.integrator.empty()) options["integrator"] = o.integrator;
+  BuiltModel built = make_model(o.model, scene, mesh, options);
   std::vector<std::string> names;
   for (const Tool& t : scene.tools) names.push_back(t.name);
   const ForceProfile profile = run_model(
@@ -110,6 +113,7 @@ void add_run_command(CLI::App& app) {
   run->add_option("scene", options->scene, "scene file or name")->required();
   run->add_option("--model", options->model, "model name (see `kerf models`)")->required();
   run->add_option("-o,--output", options->out, "output directory (default runs/SCENE/MODEL)");
+  run->add_option("--integrator", options->integrator, "time integrator of models that take one (springs: explicit|implicit|static)");
   run->add_option("--trajectory", options->trajectory, "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   run->callback([options] { run_run(*options); });
 }

@@ -10,6 +10,10 @@ namespace kerf {
 void require_fracture_inputs(const Scene& scene);
 BuiltModel build_fracture_model(const Scene& scene, const TetMesh& mesh);
 
+/// Paper 000 §2, realtime/springs (springs_builder.cpp); option "integrator".
+void require_springs_inputs(const Scene& scene);
+BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const ModelOptions& options);
+
 /// Paper 000 §3.1/§3.3, realtime/edge (edge_builder.cpp).
 void require_edge_inputs(const Scene& scene);
 BuiltModel build_edge_model(const Scene& scene, const TetMesh& mesh);

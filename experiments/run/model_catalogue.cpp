@@ -11,6 +11,8 @@ struct CatalogueEntry {
   ModelDescription description;
   void (*require_inputs)(const Scene&);
   BuiltModel (*build)(const Scene&, const TetMesh&);
+  /// For a model that takes options (then `build` may be null).
+  BuiltModel (*build_with_options)(const Scene&, const TetMesh&, const ModelOptions&) = nullptr;
 };
 
 const CatalogueEntry catalogue[] = {
@@ -29,6 +31,9 @@ const CatalogueEntry catalogue[] = {
       PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction},
       "one sphere (cutting stick)"},
      &require_voxel_inputs, &build_voxel_model},
+    {{"springs", "cubic 28-spring network around the stylus(es), E and ν identified, embedding, tearing; --integrator explicit|implicit|static",
+      "paper 000 §2.1, §2.2", PhenomenonSet{Phenomenon::deformation, Phenomenon::tearing}, "one or two spheres (styluses)"},
+     &require_springs_inputs, nullptr, &build_springs_model},
 };
 
 const std::vector<ModelDescription> descriptions = [] {
@@ -81,9 +86,13 @@ const ModelDescription& require_model_for_scene(std::string_view name, const Sce
   return d;
 }
 
-BuiltModel make_model(std::string_view name, const Scene& scene, const TetMesh& mesh) {
+BuiltModel make_model(std::string_view name, const Scene& scene, const TetMesh& mesh, const ModelOptions& options) {
   require_model_for_scene(name, scene);
-  return find_entry(name)->build(scene, mesh);
+  const CatalogueEntry* entry = find_entry(name);
+  if (entry->build_with_options) return entry->build_with_options(scene, mesh, options);
+  if (!options.empty())
+    throw std::invalid_argument("model " + std::string(name) + " takes no options (got \"" + options.begin()->first + "\")");
+  return entry->build(scene, mesh);
 }
 
 } // namespace kerf

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <map>
 #include <memory>
 #include <span>
 #include <stdexcept>
@@ -54,9 +55,13 @@ struct ToughnessRegions {
 };
 ToughnessRegions toughness_regions(const Scene& scene);
 
+/// Options a model takes from the command line (`kerf run --integrator implicit` gives
+/// {"integrator": "implicit"}); a model that takes none refuses any.
+using ModelOptions = std::map<std::string, std::string, std::less<>>;
+
 /// Builds model `name` for `scene` on its mesh (after require_model_for_scene). Throws ModelMismatch when the model cannot
 /// represent a phenomenon the scene declares, or lacks a tool or parameter section it needs —
 /// naming what is missing — and std::invalid_argument for an unknown model name.
-BuiltModel make_model(std::string_view name, const Scene& scene, const TetMesh& mesh);
+BuiltModel make_model(std::string_view name, const Scene& scene, const TetMesh& mesh, const ModelOptions& options = {});
 
 } // namespace kerf

@@ -219,6 +219,8 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   m_initial = std::move(net);
   m_omega_max = highest_angular_frequency(m_initial);
   m_stability_limit = symplectic_euler_stability_limit(m_omega_max, m_initial.damping_time);
+  m_gershgorin_work.assign(static_cast<std::size_t>(m_initial.node_capacity()), 0.0);
+  m_gershgorin_rest = gershgorin_frequency_bound(m_initial, m_initial.rest, m_gershgorin_work);
 }
 
 int SpringNetworkModel::attached_nodes(int stylus) const {
@@ -271,7 +273,11 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
   };
   bool over_budget = false;
   if (m_setup.integrator == SpringIntegrator::symplectic_euler) {
-    const double ratio = dt / (explicit_safety * m_stability_limit);
+    // The rest-state limit, shortened when the deformed tangent's Gershgorin bound has grown
+    // (crushed springs, stretched cells): h_crit √(G_rest / G_now).
+    const double g_now = gershgorin_frequency_bound(m_net, m_x, m_gershgorin_work);
+    const double limit = m_stability_limit * std::sqrt(std::min(1.0, m_gershgorin_rest / std::max(g_now, 1e-300)));
+    const double ratio = dt / (explicit_safety * limit);
     int substeps = std::isfinite(ratio) ? static_cast<int>(std::ceil(ratio)) : 1;
     if (substeps > max_substeps) substeps = max_substeps, over_budget = true;
     substeps = std::max(substeps, 1);

@@ -108,6 +108,8 @@ private:
   bool m_started = false;
   double m_omega_max = 0.0;
   double m_stability_limit = 0.0;
+  double m_gershgorin_rest = 0.0;    ///< Gershgorin bound at rest [1/s²]
+  std::vector<double> m_gershgorin_work;
   int m_last_substeps = 0;
   int m_tears = 0;
   int m_pieces = 1;

@@ -2,6 +2,9 @@
 
 #include "realtime/springs/network_system.hpp"
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
 #include <cmath>
 
 namespace kerf {
@@ -40,6 +43,42 @@ double symplectic_euler_stability_limit(double omega_max, double damping_time) {
   const double zeta = 0.5 * damping_time * omega_max;
   // h <= (2/ω)(√(1+ζ²) − ζ)
   return 2.0 / omega_max * (std::sqrt(1.0 + zeta * zeta) - zeta);
+}
+
+double gershgorin_frequency_bound(const SpringNetwork& net, const Eigen::Matrix3Xd& x, std::vector<double>& work) noexcept {
+  std::fill(work.begin(), work.begin() + net.node_count, 0.0);
+  const double h = net.block.cell_size;
+  const double kappa = net.stiffness.volume_modulus;
+  Eigen::Matrix<double, 3, 8> xc;
+  for (const auto& nodes : net.cell_nodes) {
+    for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
+    for (const CellSpring& sp : cell_springs) {
+      const double l = (xc.col(sp.b) - xc.col(sp.a)).norm();
+      const double L = net.rest_length(sp.type);
+      const double row = 2.0 * net.spring_constant(sp.type) * std::max(1.0, l > 0.0 ? std::abs(1.0 - L / l) : 1e6);
+      work[static_cast<std::size_t>(nodes[static_cast<std::size_t>(sp.a)])] += row;
+      work[static_cast<std::size_t>(nodes[static_cast<std::size_t>(sp.b)])] += row;
+    }
+    if (kappa > 0.0) {
+      const Eigen::Matrix3d F = cell_deformation_gradient(xc, h);
+      Eigen::Matrix3d cof;
+      cof.col(0) = F.col(1).cross(F.col(2));
+      cof.col(1) = F.col(2).cross(F.col(0));
+      cof.col(2) = F.col(0).cross(F.col(1));
+      double norms[8], total = 0.0;
+      for (int a = 0; a < 8; ++a) {
+        const Eigen::Vector3d s_a(2.0 * (a & 1) - 1.0, 2.0 * ((a >> 1) & 1) - 1.0, 2.0 * ((a >> 2) & 1) - 1.0);
+        norms[a] = (cof * s_a / (4.0 * h)).norm();
+        total += norms[a];
+      }
+      for (int a = 0; a < 8; ++a) work[static_cast<std::size_t>(nodes[static_cast<std::size_t>(a)])] += kappa * h * h * h * norms[a] * total;
+    }
+  }
+  double bound = 0.0;
+  for (int p = 0; p < net.node_count; ++p)
+    if (net.constraint[static_cast<std::size_t>(p)] != fix_all)
+      bound = std::max(bound, work[static_cast<std::size_t>(p)] / net.mass[static_cast<std::size_t>(p)]);
+  return bound;
 }
 
 double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
