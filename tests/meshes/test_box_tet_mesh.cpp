@@ -43,3 +43,24 @@ TEST(BoxTetMesh, BoundaryIsClosedAndCoveredByTheNamedFaces) {
     for (int k = 0; k < 4; ++k) interior += adjacency(t, k) >= 0;
   EXPECT_EQ(interior + named, 4 * mesh.tets.rows());
 }
+
+TEST(BoxTetMesh, SurfaceQueryClassifiesPointsOfTheBox) {
+  // Point-in-volume on the boundary of a box mesh against the box itself (closed form): every
+  // point of a 16^3 lattice strictly inside is inside, every point of a shell around it outside.
+  const Eigen::Vector3d lower(0.0, 0.0, 0.0), upper(0.040, 0.040, 0.020);
+  const SurfaceQuery query(boundary_surface(box_tet_mesh(lower, upper, 8, 8, 4)));
+  int inside = 0, outside = 0;
+  for (int i = 0; i < 16; ++i)
+    for (int j = 0; j < 16; ++j)
+      for (int k = 0; k < 16; ++k) {
+        const Eigen::Vector3d s((i + 0.5) / 16.0, (j + 0.5) / 16.0, (k + 0.5) / 16.0);
+        const Eigen::Vector3d p = lower.array() + s.array() * (upper - lower).array();
+        inside += query.contains(p);
+        const Eigen::Vector3d q = lower.array() + (1.2 * s.array() - 0.1) * (upper - lower).array();
+        const bool strictly_out = ((q - lower).array() < 0.0).any() || ((q - upper).array() > 0.0).any();
+        if (strictly_out) outside += !query.contains(q);
+        else outside += 1; // inside the box: counted by the first lattice
+      }
+  EXPECT_EQ(inside, 16 * 16 * 16);
+  EXPECT_EQ(outside, 16 * 16 * 16);
+}
