@@ -7,25 +7,13 @@
 #include "realtime/voxel/voxel_surface_cutting_model.hpp"
 
 #include <functional>
-#include <utility>
 
 namespace kerf::test {
 
 /// Surface of a cube of edge `edge` [m] with `cells` tetrahedral cells per edge: x in [0, edge],
 /// y centred, z in [0, edge] (the axes of the sponge scenes).
-/// Tetrahedra of negative volume are re-oriented first: box_tet_mesh at this commit swaps the
-/// vertices of the even permutations {1,2,0} and {2,0,1} too (`bool odd = count; odd % 2`),
-/// which inverts a third of its tetrahedra and with them the boundary's orientation.
 inline SurfaceMesh cube_surface(double edge, int cells) {
-  TetMesh mesh = box_tet_mesh({0.0, -0.5 * edge, 0.0}, {edge, 0.5 * edge, edge}, cells, cells, cells);
-  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t) {
-    const Eigen::Vector3d a = mesh.nodes.row(mesh.tets(t, 0)).transpose();
-    const Eigen::Vector3d b = mesh.nodes.row(mesh.tets(t, 1)).transpose();
-    const Eigen::Vector3d c = mesh.nodes.row(mesh.tets(t, 2)).transpose();
-    const Eigen::Vector3d d = mesh.nodes.row(mesh.tets(t, 3)).transpose();
-    if ((b - a).cross(c - a).dot(d - a) < 0.0) std::swap(mesh.tets(t, 2), mesh.tets(t, 3));
-  }
-  return boundary_surface(mesh);
+  return boundary_surface(box_tet_mesh({0.0, -0.5 * edge, 0.0}, {edge, 0.5 * edge, edge}, cells, cells, cells));
 }
 
 /// Paper 002 Table 1 (sponge) as the builder reads it: k_e = 20 N/mm, b = 0.5 N s/mm, μ = 0.8,
