@@ -1,0 +1,77 @@
+#pragma once
+// The scene-level reference run (issue 3): the scene mapped to a finite-strain problem (materials
+// per region, supports, the tool as a rigid body), the chosen trajectory samples solved along a
+// load path with cut-back, and the result written as profile.csv + manifest.json, fields.pvd with
+// a .vtu per solved sample, a progress line per sample, and checkpoints to resume from.
+//
+// Includes reference/*.hpp only, which include no deal.II.
+
+#include "experiments/profile/force_profile.hpp"
+#include "experiments/scene/scene.hpp"
+#include "meshes/tet_mesh.hpp"
+#include "reference/finite_strain_solver.hpp"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kerf {
+
+/// What `run_reference` solves and writes.
+struct ReferenceRunSettings {
+  int degree = 1;      ///< FE_SimplexP degree, 1 or 2
+  int refinements = 0; ///< global refinements of the scene mesh
+  std::vector<std::size_t> sample_indices; ///< trajectory samples to solve, ascending; empty = every sample
+  bool write_fields = true; ///< dir/fields.pvd + dir/fields/step_NNNN.vtu
+  int checkpoint_every = 5; ///< write dir/checkpoint.bin after every this many solved samples (>= 1)
+  bool resume = false;      ///< continue from dir/checkpoint.bin if it exists
+};
+
+/// How the scene's tool is coupled to the body in the reference.
+struct ReferenceToolCoupling {
+  enum class Kind {
+    penalty, ///< frictionless penalty contact with the rigid tool (a blade, or a pressing sphere)
+    tied     ///< the surface nodes under the stylus move with it (paper 000 §2.1: "the vertices at
+             ///< the stylus tip fixed to the stylus"): a sphere that starts touching and moves away
+  };
+  Kind kind = Kind::penalty;
+  Eigen::Vector3d contact_point = Eigen::Vector3d::Zero(); ///< tied: the body point first touched [m]
+  std::vector<int> tied_triangles; ///< tied: rows of the `top` surface group tied to the stylus
+  std::size_t tied_nodes = 0;      ///< tied: distinct mesh nodes of those triangles
+};
+
+/// The scene as the reference's boundary-value problem, and how its tool is coupled.
+struct ReferenceProblem {
+  reference::FiniteStrainProblem problem;
+  ReferenceToolCoupling coupling;
+  /// The tool's reference point at each trajectory sample [m] and the sample times [s].
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<double> times;
+};
+
+/// Maps the scene to the reference problem: materials per region (layers first, then `body`,
+/// with the scene's law), bonded/sliding supports, and the tool: a blade as a wedge, a sphere in
+/// penalty contact, or — a sphere whose start touches the body and whose trajectory never moves
+/// towards it (clay_pull) — tied: the `top` triangles whose three nodes lie within the sphere
+/// radius of the first contact point (if none, those with at least one such node) get the
+/// prescribed displacement u = p(t) − p(0), the tool displacement since contact. Throws
+/// std::invalid_argument for a scene with more than one tool, or a tied tool without a `top`
+/// surface. The load factor of sample k is t_k / T (T the trajectory duration).
+ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh);
+
+/// Runs the reference on the scene (see file comment) and returns the profile: one row per solved
+/// sample (t, tool position, force of the body on the tool, mode no-contact when the tool force is
+/// zero (tied) / no contact point (penalty) else deformation-1, crack_extent 0, cost_s = solve
+/// seconds). The tool force of a tied tool is the reaction on the tied nodes. If the load path
+/// stops (cut-backs exhausted), returns the profile up to the last converged sample and records
+/// the stop message in the manifest. Writes dir/profile.csv, dir/manifest.json, fields and
+/// checkpoints; prints a progress line per sample on stderr. Throws std::invalid_argument on bad
+/// settings, std::runtime_error on an unreadable or mismatched checkpoint.
+ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings,
+                           const std::filesystem::path& dir);
+
+} // namespace kerf

@@ -1,0 +1,105 @@
+// The scene-level reference run (experiments/run/reference_run.hpp) on clay_pull's scene with a
+// coarse gmsh-free box of the same size (40 × 40 × 20 mm): the stylus is tied (paper 000 §2.1),
+// the tool force balances the support reaction (global equilibrium: no other load acts on the
+// body), and a run resumed from its checkpoint gives the uninterrupted profile exactly.
+
+#include "experiments/run/reference_run.hpp"
+#include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/study_runner.hpp"
+#include "experiments/trajectory/trajectory.hpp"
+#include "meshes/box_tet_mesh.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <fstream>
+
+namespace kerf {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ClayPull {
+  Scene scene = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
+  // clay_pull.toml: 40 × 40 × 20 mm block, x in [0, 40], y centred, base z = 0.
+  TetMesh mesh = box_tet_mesh(Eigen::Vector3d(0, -0.02, 0), Eigen::Vector3d(0.04, 0.02, 0.02), 4, 4, 2);
+  std::size_t samples = sample(scene.tools.front().trajectory).samples.size();
+};
+
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("kerf_reference_run_" + std::to_string(::getpid())) / name;
+  fs::remove_all(dir);
+  return dir;
+}
+
+nlohmann::json read_json(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
+
+TEST(ReferenceRun, ClayPullStylusIsTiedAndItsForceBalancesTheSupport) {
+  const ClayPull c;
+  const ReferenceProblem rp = reference_problem(c.scene, c.mesh);
+  ASSERT_EQ(rp.coupling.kind, ReferenceToolCoupling::Kind::tied);
+  EXPECT_FALSE(rp.problem.tool.has_value());
+  EXPECT_NEAR(rp.coupling.contact_point.z(), 0.02, 1e-12); // the top face under the stylus
+
+  ReferenceRunSettings s;
+  s.sample_indices = reference_sample_indices(c.samples, 4);
+  s.write_fields = true;
+  const fs::path dir = scratch("tied");
+  const ForceProfile profile = run_reference(c.scene, c.mesh, s, dir);
+  ASSERT_EQ(profile.rows.size(), 4u);
+  EXPECT_EQ(profile.rows.front().mode, InteractionMode::no_contact); // not yet pulled: zero force
+  const nlohmann::json m = read_json(dir / "manifest.json");
+  EXPECT_TRUE(m.at("stopped").is_null());
+  EXPECT_EQ(m.at("solver").at("tool_coupling"), "tied");
+  for (std::size_t k = 1; k < profile.rows.size(); ++k) {
+    const ProfileRow& r = profile.rows[k];
+    EXPECT_EQ(r.mode, InteractionMode::deformation_1);
+    EXPECT_LT(r.force.z(), 0.0); // the body holds the stylus back as it pulls up
+    const auto& rec = m.at("samples").at(k);
+    const Eigen::Vector3d support(rec.at("support_reaction_N")[0].get<double>(), rec.at("support_reaction_N")[1].get<double>(),
+                                  rec.at("support_reaction_N")[2].get<double>());
+    // Newton's third law over the whole body: tool force = −support reaction.
+    EXPECT_LT((r.force + support).norm(), 1e-6 * r.force.norm()) << "sample " << k;
+  }
+  EXPECT_TRUE(fs::exists(dir / "fields.pvd"));
+  EXPECT_TRUE(fs::exists(dir / "fields" / "step_0003.vtu"));
+  EXPECT_EQ(read_profile_csv(dir / "profile.csv").rows.size(), 4u);
+}
+
+TEST(ReferenceRun, ResumeFromACheckpointGivesTheUninterruptedProfile) {
+  const ClayPull c;
+  ReferenceRunSettings s;
+  s.sample_indices = reference_sample_indices(c.samples, 5);
+  s.write_fields = false;
+  s.checkpoint_every = 3;
+  const ForceProfile whole = run_reference(c.scene, c.mesh, s, scratch("whole"));
+
+  // The interrupted run: its last checkpoint is after sample 3 of 5; its final files are removed
+  // as if it had been killed before writing them.
+  const fs::path dir = scratch("interrupted");
+  run_reference(c.scene, c.mesh, s, dir);
+  fs::remove(dir / "profile.csv");
+  fs::remove(dir / "manifest.json");
+  s.resume = true;
+  const ForceProfile resumed = run_reference(c.scene, c.mesh, s, dir);
+  EXPECT_EQ(read_json(dir / "manifest.json").at("resumed_after_sample"), 3);
+
+  ASSERT_EQ(resumed.rows.size(), whole.rows.size());
+  for (std::size_t k = 0; k < whole.rows.size(); ++k) {
+    EXPECT_EQ(resumed.rows[k].t, whole.rows[k].t);
+    EXPECT_EQ(resumed.rows[k].position, whole.rows[k].position);
+    EXPECT_EQ(resumed.rows[k].force, whole.rows[k].force) << "row " << k; // bit for bit
+    EXPECT_EQ(resumed.rows[k].mode, whole.rows[k].mode);
+  }
+
+  // A checkpoint of other settings is refused.
+  s.degree = 2;
+  EXPECT_THROW(run_reference(c.scene, c.mesh, s, dir), std::runtime_error);
+}
+
+} // namespace
+} // namespace kerf

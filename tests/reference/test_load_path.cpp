@@ -1,0 +1,81 @@
+// The load path's cut-back (reference/load_path.hpp): an increment too large for the Newton
+// budget is bisected and the path recovers to the same equilibrium as a finely stepped solve
+// (hyperelasticity is path-independent: the discrete equilibrium at a given load does not depend
+// on the steps that reached it); when the cut-backs are exhausted the path stops naming the
+// sample, and the solver keeps the last converged state.
+
+#include "reference/finite_strain_solver.hpp"
+#include "reference/load_path.hpp"
+#include "tests/reference/reference_test_meshes.hpp"
+
+#include <gtest/gtest.h>
+
+namespace kerf::reference {
+namespace {
+
+/// A 20 mm cube, bonded at z = 0, its top face pulled up by load × 40% of the height.
+FiniteStrainProblem stretched_cube() {
+  const double H = 0.02;
+  FiniteStrainProblem p;
+  p.mesh = test::named_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(H, H, H), 2, 2, 2);
+  p.materials.push_back({"body", LawKind::neo_hookean, 1e5, 0.3});
+  p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::bonded, {}, {}});
+  p.displacement_boundaries.push_back({"zmax", DisplacementBoundary::Kind::prescribed,
+                                       [H](const Eigen::Vector3d&, double load) {
+                                         return Eigen::Vector3d(0.0, 0.0, 0.4 * H * load);
+                                       },
+                                       {true, true, true}});
+  return p;
+}
+
+TEST(LoadPath, CutsBackAnOverLargeIncrementAndRecovers) {
+  const FiniteStrainProblem p = stretched_cube();
+  SolverSettings tight;
+  tight.max_newton_iterations = 3; // too few for the whole 40% stretch in one increment
+  FiniteStrainSolver solver(p, tight);
+  LoadPath path(solver, LoadState{});
+  const LoadStepReport r = path.advance({LoadState{1.0, Eigen::Vector3d::Zero()}, 7, 0.25});
+  EXPECT_TRUE(r.converged);
+  EXPECT_GE(r.cutbacks, 1);
+  EXPECT_LE(r.cutbacks, 6);
+  EXPECT_GT(r.increments, 1);
+  EXPECT_DOUBLE_EQ(path.last_converged_load().load_factor, 1.0);
+
+  // Independent second solve: the default Newton budget, 20 equal load steps.
+  FiniteStrainSolver fine(p, SolverSettings{});
+  EquilibriumReport f;
+  for (int k = 1; k <= 20; ++k) {
+    f = fine.solve({0.05 * k, Eigen::Vector3d::Zero()});
+    ASSERT_TRUE(f.converged) << f.failure;
+  }
+  const Eigen::Vector3d X(0.01, 0.01, 0.01); // the cube's centre
+  EXPECT_LT((solver.displacement_at(X) - fine.displacement_at(X)).norm(), 1e-9 * fine.displacement_at(X).norm());
+  EXPECT_LT((r.support_reaction - f.support_reaction).norm(), 1e-6 * f.support_reaction.norm() + 1e-12);
+}
+
+TEST(LoadPath, StopsNamingTheSampleAndKeepsTheLastConvergedState) {
+  const FiniteStrainProblem p = stretched_cube();
+  SolverSettings one;
+  one.max_newton_iterations = 1; // one Newton step never meets 1e-9 on a nonlinear increment
+  FiniteStrainSolver solver(p, one);
+  LoadPath path(solver, LoadState{}, LoadPathSettings{2});
+  const std::vector<double> before = solver.state();
+  try {
+    path.advance({LoadState{1.0, Eigen::Vector3d::Zero()}, 12, 0.375});
+    FAIL() << "the load path did not stop";
+  } catch (const LoadPathError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.sample(), 12u);
+    EXPECT_DOUBLE_EQ(e.time(), 0.375);
+    EXPECT_NE(what.find("sample 12 (t = 0.375 s)"), std::string::npos) << what;
+    EXPECT_NE(what.find("after 2 cut-backs"), std::string::npos) << what;
+    EXPECT_NE(what.find("residual history"), std::string::npos) << what;
+    EXPECT_NE(what.find("last converged state"), std::string::npos) << what;
+  }
+  EXPECT_EQ(solver.state(), before);
+  EXPECT_EQ(path.last_converged_state(), before);
+  EXPECT_THROW((void)LoadPath(solver, LoadState{}, LoadPathSettings{-1}), std::invalid_argument);
+}
+
+} // namespace
+} // namespace kerf::reference
