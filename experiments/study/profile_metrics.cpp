@@ -44,7 +44,7 @@ ProfileMetrics compare_profiles(const ForceProfile& model, const ForceProfile& r
     peak_reference = std::max(peak_reference, r[k]->force.norm());
     if (m[k]->mode == r[k]->mode) ++same_mode;
   }
-  if (!(peak_reference > 0.0)) throw std::invalid_argument("compare profiles: the reference force is zero throughout");
+  if (!(peak_reference > 0.0)) throw std::invalid_argument("not scored: the reference force is zero on every compared sample");
   const auto n = static_cast<double>(m.size());
   out.normalised_rms_force_error = std::sqrt(sum_squared / n) / peak_reference;
   out.peak_force_error = (peak_model - peak_reference) / peak_reference;
@@ -55,7 +55,7 @@ ProfileMetrics compare_profiles(const ForceProfile& model, const ForceProfile& r
 
   const std::size_t last = m.size() - 1;
   const double work_model = tool_work(model, tool, 0, last), work_reference = tool_work(reference, tool, 0, last);
-  if (!(std::abs(work_reference) > 0.0)) throw std::invalid_argument("compare profiles: the reference does no work");
+  if (!(std::abs(work_reference) > 0.0)) throw std::invalid_argument("not scored: the reference does no work on the compared samples");
   out.work_error = (work_model - work_reference) / std::abs(work_reference);
 
   if (cutting && cutting->force > 0.0) {
