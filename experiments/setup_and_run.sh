@@ -34,6 +34,7 @@ case "$job" in
     cd "$here"
     "$build/experiments/kerf" mesh potato_rect_cut
     "$build/experiments/kerf" run potato_rect_cut --model fracture
+    "$build/experiments/kerf" study default --results-doc docs/results.md
     ;;
   test)
     cd "$build"

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   kerf::cli::add_haptic_command(app);
   kerf::cli::add_device_sim_command(app);
   kerf::cli::add_stability_command(app);
+  kerf::cli::add_study_command(app);
   kerf::cli::add_reference_command(app);
   try {
     app.parse(argc, argv);

@@ -1,6 +1,7 @@
 #include "experiments/study/study_runner.hpp"
 
 #include "experiments/run/model_catalogue.hpp"
+#include "experiments/run/reference_run.hpp"
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
@@ -32,6 +33,32 @@ ForceProfile subsample(const ForceProfile& profile, const std::vector<std::size_
   for (const ProfileRow& r : profile.rows) {
     const std::size_t k = seen[r.tool]++;
     if (std::binary_search(indices.begin(), indices.end(), k)) out.rows.push_back(r);
+  }
+  return out;
+}
+
+ReferenceRunner finite_element_reference() {
+  return [](const Scene& scene, const StudyReferenceSpec& spec, int level, const std::vector<std::size_t>& indices,
+            const std::filesystem::path& dir) {
+    ReferenceRunSettings settings;
+    settings.degree = spec.degree;
+    settings.refinements = level;
+    settings.sample_indices = indices;
+    settings.write_fields = false;
+    return run_reference(scene, scene_mesh(scene), settings, dir);
+  };
+}
+
+ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b) {
+  std::map<std::string, std::vector<double>> times;
+  for (const ProfileRow& r : b.rows) times[r.tool].push_back(r.t);
+  for (auto& [tool, t] : times) std::sort(t.begin(), t.end());
+  ForceProfile out;
+  for (const ProfileRow& r : a.rows) {
+    const auto it = times.find(r.tool);
+    if (it == times.end()) continue;
+    const auto lo = std::lower_bound(it->second.begin(), it->second.end(), r.t - 1e-9);
+    if (lo != it->second.end() && *lo <= r.t + 1e-9) out.rows.push_back(r);
   }
   return out;
 }
@@ -91,7 +118,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       if (&profile == finest) continue;
       StudyRow row{scene.name, "reference L" + std::to_string(level), std::nullopt, cost_statistics(profile), ""};
       try {
-        row.metrics = compare_profiles(profile, *finest, tool);
+        row.metrics = compare_profiles(at_common_times(profile, *finest), at_common_times(*finest, profile), tool);
       } catch (const std::exception& e) {
         row.note = e.what();
       }
@@ -114,7 +141,9 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
         const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
         write_run(out / scene.name / model, profile, run_manifest(scene, built, mesh, profile, wall));
         row.cost = cost_statistics(profile);
-        if (finest) row.metrics = compare_profiles(subsample(profile, indices), *finest, tool, expected_cutting(scene));
+        if (finest)
+          row.metrics = compare_profiles(at_common_times(profile, *finest), at_common_times(*finest, profile), tool,
+                                         expected_cutting(scene));
       } catch (const std::exception& e) {
         row.note = e.what();
       }

@@ -24,6 +24,11 @@ using ReferenceRunner = std::function<ForceProfile(const Scene& scene, const Stu
                                                    int refinement, const std::vector<std::size_t>& sample_indices,
                                                    const std::filesystem::path& dir)>;
 
+/// The finite-element reference (reference/, through experiments/run/reference_run.hpp) as a
+/// study calls it: the chosen samples at the given mesh level, no field files (`kerf reference`
+/// writes those).
+ReferenceRunner finite_element_reference();
+
 /// One row of the study table.
 struct StudyRow {
   std::string scene;
@@ -49,5 +54,10 @@ std::vector<std::size_t> reference_sample_indices(std::size_t n, int count);
 
 /// The rows of `profile` whose sample index (row order per tool) is in `indices`.
 ForceProfile subsample(const ForceProfile& profile, const std::vector<std::size_t>& indices);
+
+/// The rows of `a` whose tool and time (to 1e-9 s) also appear in `b`: the samples two runs have
+/// in common — a reference that stopped early (a blade pressed further than an uncut body can
+/// take) is compared on the samples it solved.
+ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b);
 
 } // namespace kerf

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include <unistd.h>
@@ -91,4 +92,61 @@ TEST(StudyRunner, TwoScenesWithoutAReferenceReportCostsOnly) {
   }
   EXPECT_EQ(r.reference_runs, 0);
   EXPECT_EQ(r.table().row_count(), 2u);
+}
+
+TEST(StudyRunner, CommonTimesKeepOnlyTheSamplesBothRunsHave) {
+  // A reference that stopped after t = 2 is compared with a model on t = 0, 1, 2 only.
+  ForceProfile model, reference;
+  for (int k = 0; k < 6; ++k) {
+    ProfileRow r;
+    r.tool = "blade";
+    r.t = 0.5 * k; // 0, 0.5, ..., 2.5
+    model.rows.push_back(r);
+  }
+  for (int k = 0; k < 3; ++k) {
+    ProfileRow r;
+    r.tool = "blade";
+    r.t = k + 1e-12; // 0, 1, 2 (within the 1e-9 s tolerance)
+    reference.rows.push_back(r);
+  }
+  const ForceProfile common = at_common_times(model, reference);
+  ASSERT_EQ(common.rows.size(), 3u);
+  EXPECT_EQ(common.rows[1].t, 1.0);
+  EXPECT_EQ(common.rows[2].t, 2.0);
+  EXPECT_EQ(at_common_times(reference, model).rows.size(), 3u);
+}
+
+TEST(StudyRunner, EndToEndWithTheReferenceAndItsCache) {
+  // Two scenes, two models, the finite-element reference at one coarse level on 4 samples. The
+  // springs model on clay_pull is scored against the reference; the fracture model on the wedge
+  // is run but, the uncut reference transmitting no force through a sharp blade, not scored (the
+  // note says why). A second run takes the reference from the cache: no reference solve.
+  const StudySpec spec = read_study(write_study(
+      "e2e.toml", "[study]\nname = \"e2e\"\nscenes = [\"clay_pull\", \"potato_wedge_cut\"]\n"
+                  "models = [\"springs\", \"fracture\"]\n[reference]\ndegree = 1\nrefinements = [0]\nsamples = 4\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_e2e_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const StudyResult first = run_study(spec, out, finite_element_reference());
+  EXPECT_EQ(first.reference_runs, 2);
+  bool scored = false;
+  for (const StudyRow& row : first.rows) {
+    if (row.scene == "clay_pull" && row.model == "springs") {
+      ASSERT_TRUE(row.metrics.has_value()) << row.note;
+      EXPECT_TRUE(std::isfinite(row.metrics->normalised_rms_force_error));
+      EXPECT_EQ(row.metrics->samples, 4u);
+      scored = true;
+    }
+    if (row.scene == "potato_wedge_cut") {
+      EXPECT_EQ(row.model, "fracture");
+    }
+  }
+  EXPECT_TRUE(scored);
+  const StudyResult second = run_study(spec, out, finite_element_reference());
+  EXPECT_EQ(second.reference_runs, 0);
+  ASSERT_EQ(second.rows.size(), first.rows.size());
+  for (std::size_t k = 0; k < first.rows.size(); ++k) {
+    if (first.rows[k].metrics && second.rows[k].metrics) {
+      EXPECT_EQ(first.rows[k].metrics->normalised_rms_force_error, second.rows[k].metrics->normalised_rms_force_error);
+    }
+  }
 }
