@@ -4,6 +4,7 @@
 
 #include "experiments/cli/commands.hpp"
 #include "experiments/run/reference_run.hpp"
+#include "experiments/run/session_replay.hpp"
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
@@ -25,12 +26,15 @@ struct ReferenceOptions {
   int samples = 0; ///< 0 = every trajectory sample
   bool resume = false;
   bool no_fields = false;
+  std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
 };
 
 void run_reference_command(const ReferenceOptions& o) {
   namespace fs = std::filesystem;
-  const Scene scene = read_scene(resolve_scene(o.scene));
-  const fs::path out = o.out.empty() ? fs::path("runs") / scene.name / "reference" : fs::path(o.out);
+  const Scene read = read_scene(resolve_scene(o.scene));
+  const fs::path out = o.out.empty() ? fs::path("runs") / read.name / "reference" : fs::path(o.out);
+  // A recorded session replays what the hand did at the rig through the ground truth.
+  const Scene scene = o.trajectory.empty() ? read : replay_session(read, o.trajectory, out);
   ReferenceRunSettings settings;
   settings.degree = o.degree;
   settings.refinements = o.refine;
@@ -67,6 +71,8 @@ void add_reference_command(CLI::App& app) {
   cmd->add_option("-o,--output", options->out, "output directory (default runs/SCENE/reference)");
   cmd->add_flag("--resume", options->resume, "continue from DIR/checkpoint.bin");
   cmd->add_flag("--no-fields", options->no_fields, "do not write fields.pvd and the .vtu files");
+  cmd->add_option("--trajectory", options->trajectory,
+                  "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   cmd->callback([options] { run_reference_command(*options); });
 }
 

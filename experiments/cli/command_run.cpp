@@ -5,9 +5,9 @@
 #include "experiments/run/model_catalogue.hpp"
 #include "experiments/run/run_model.hpp"
 #include "experiments/run/scene_mesh.hpp"
+#include "experiments/run/session_replay.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "realtime/fracture/contact_length.hpp"
-#include "realtime/haptics/session_file.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -25,26 +25,6 @@ struct RunOptions {
   std::string integrator; ///< forwarded to the model as option "integrator"
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
 };
-
-/// The tool positions of a recorded haptic session (realtime/haptics/session_file.hpp), one
-/// trajectory per scene tool, matched by name, at the session's servo rate.
-std::vector<SampledTrajectory> session_trajectories(const std::string& file, const std::vector<std::string>& tools) {
-  const Session session = read_session(file);
-  const auto states = session_tool_states(session);
-  std::vector<SampledTrajectory> out;
-  for (const std::string& name : tools) {
-    const auto& recorded = session.header.tools;
-    const auto at = std::find(recorded.begin(), recorded.end(), name);
-    if (at == recorded.end()) throw std::invalid_argument(file + ": the session has no tool named " + name);
-    if (session.ticks.empty()) throw std::invalid_argument(file + ": the session has no ticks");
-    SampledTrajectory t;
-    t.rate = session.header.rate;
-    t.samples = states[static_cast<std::size_t>(at - recorded.begin())];
-    t.labels.assign(t.samples.size(), "session");
-    out.push_back(std::move(t));
-  }
-  return out;
-}
 
 /// The paper 001 check printed after a cutting run: the steady cutting force beside J_c l
 /// (Eq. 10), l measured on the mesh at the median cutting sample.

@@ -40,6 +40,15 @@ paste -d, <(tail -n +4 session.csv | cut -d, -f15-17,21) <(tail -n +2 offline/pr
 [ "$(tail -n +2 received.csv | wc -l)" -gt 1000 ] || { echo "device-sim received too few commands"; exit 1; }
 echo "1. session matches the offline run ($(tail -n +4 session.csv | wc -l) ticks)"
 
+# 1b. the same session through the finite-element reference: its tool path is the recorded one
+# (one row per session tick in the replayed trajectory), solved at 3 evenly spaced samples
+"$KERF" reference "$SCENE" --trajectory session.csv --samples 3 --no-fields -o replayed > reference.log 2>&1 ||
+  { cat reference.log; exit 1; }
+[ "$(tail -n +2 replayed/session_blade.csv | wc -l)" -eq "$(tail -n +4 session.csv | wc -l)" ] ||
+  { echo "the replayed trajectory does not have one row per session tick"; exit 1; }
+[ "$(tail -n +2 replayed/profile.csv | wc -l)" -eq 3 ] || { echo "expected 3 reference samples"; exit 1; }
+echo "1b. kerf reference --trajectory replays the session"
+
 # 2. SIGKILL the device mid-session
 start_sim sim2.log
 "$KERF" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --duration 6 --record killed.csv \
