@@ -3,6 +3,7 @@
 
 #include "reference/finite_strain_solver.hpp"
 
+#include "reference/contact/blade_edge_contact.hpp"
 #include "reference/material/decoupled_neo_hookean.hpp"
 #include "reference/material/finite_strain_error.hpp"
 #include "reference/material/neo_hookean.hpp"
@@ -34,6 +35,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <span>
 #include <stdexcept>
 
 namespace kerf::reference {
@@ -94,6 +96,11 @@ struct FiniteStrainSolver::Impl {
   }
   std::optional<RigidToolShape> tool;
   double penalty = 0.0;
+  // Blade edge pass (blade_edge_contact.hpp): the boundary as flat facets on the nodes (P2 faces
+  // split into four at their edge midpoints), the nodes' reference positions, its settings.
+  std::vector<BoundaryFacet> facets;
+  std::vector<Eigen::Vector3d> node_positions;
+  BladeEdgeContactSettings edge_settings;
 
   dealii::SparsityPattern pattern;
   dealii::SparseMatrix<double> K;
@@ -110,6 +117,9 @@ struct FiniteStrainSolver::Impl {
     int contact_points = 0;
     double contact_area = 0.0;
     double max_pressure = 0.0;
+    int edge_points = 0;
+    double edge_length = 0.0;
+    double max_line_load = 0.0;
   };
 
   double dirichlet_target(const DirichletDof& d, double load) const {
@@ -121,6 +131,10 @@ struct FiniteStrainSolver::Impl {
   void build(const FiniteStrainProblem& problem);
   void assemble(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix, Assembly& out,
                 const dealii::AffineConstraints<double>* constraints, dealii::Vector<double>* rhs);
+  void build_blade_edge(const std::vector<dealii::Point<3>>& support, double h_min);
+  void add_blade_edge_contact(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
+                              Assembly& out, const dealii::AffineConstraints<double>* constraints,
+                              dealii::Vector<double>* rhs, dealii::Vector<double>& f_ext);
   double free_norm(const dealii::Vector<double>& r) const {
     dealii::Vector<double> copy = r;
     for (const auto& d : dirichlet) copy[d.index] = 0.0;
@@ -298,13 +312,14 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   if (tool) {
     validate(*tool);
     penalty = settings.contact_penalty;
+    double h_min = std::numeric_limits<double>::infinity();
+    for (const auto& cell : tria.active_cell_iterators())
+      for (unsigned l = 0; l < cell->n_lines(); ++l) h_min = std::min(h_min, cell->line(l)->diameter());
     if (penalty <= 0.0) {
-      double h_min = std::numeric_limits<double>::infinity();
-      for (const auto& cell : tria.active_cell_iterators())
-        for (unsigned l = 0; l < cell->n_lines(); ++l) h_min = std::min(h_min, cell->line(l)->diameter());
       // ε_N = 50 E_max / h_min: a pressure E costs a penetration of h_min / 50.
       penalty = 50.0 * *std::max_element(youngs.begin(), youngs.end()) / h_min;
     }
+    if (tool->kind == RigidToolShape::Kind::wedge) build_blade_edge(support, h_min);
   }
 
   dealii::AffineConstraints<double> structure;
@@ -322,6 +337,87 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
                                            std::move(support), settings.iterative_tolerance);
 }
 
+void FiniteStrainSolver::Impl::build_blade_edge(const std::vector<dealii::Point<3>>& support, double h_min) {
+  node_positions.resize(dof.n_dofs() / 3);
+  for (std::size_t k = 0; k < node_positions.size(); ++k) node_positions[k] = to_eigen(support[3 * k]);
+  auto node = [](dealii::types::global_dof_index i) { return static_cast<int>(i / 3); };
+  double longest = 0.0;
+  for (const auto& cell : dof.active_cell_iterators())
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary()) continue;
+      const auto face = cell->face(f);
+      std::array<int, 3> v{node(face->vertex_dof_index(0, 0)), node(face->vertex_dof_index(1, 0)),
+                           node(face->vertex_dof_index(2, 0))};
+      std::array<unsigned, 3> vi{face->vertex_index(0), face->vertex_index(1), face->vertex_index(2)};
+      // Outward: (x1 − x0) × (x2 − x0) points away from the cell's centre.
+      const Eigen::Vector3d x0 = node_positions[static_cast<std::size_t>(v[0])];
+      const Eigen::Vector3d n = (node_positions[static_cast<std::size_t>(v[1])] - x0)
+                                    .cross(node_positions[static_cast<std::size_t>(v[2])] - x0);
+      if (n.dot(x0 - to_eigen(cell->center())) < 0.0) {
+        std::swap(v[1], v[2]);
+        std::swap(vi[1], vi[2]);
+      }
+      for (int a = 0; a < 3; ++a)
+        longest = std::max(longest, (node_positions[static_cast<std::size_t>(v[static_cast<std::size_t>(a)])] -
+                                     node_positions[static_cast<std::size_t>(v[static_cast<std::size_t>((a + 1) % 3)])])
+                                        .norm());
+      if (settings.degree == 1) {
+        facets.push_back(v);
+        continue;
+      }
+      // P2: the midpoint node of the edge (vi[a], vi[a+1]) is m[a]; four flat sub-facets, each
+      // oriented as the face.
+      std::array<int, 3> m{-1, -1, -1};
+      for (unsigned l = 0; l < 3; ++l) {
+        const auto line = face->line(l);
+        for (std::size_t a = 0; a < 3; ++a) {
+          const unsigned p = vi[a], q = vi[(a + 1) % 3];
+          if ((line->vertex_index(0) == p && line->vertex_index(1) == q) ||
+              (line->vertex_index(0) == q && line->vertex_index(1) == p))
+            m[a] = node(line->dof_index(0));
+        }
+      }
+      if (std::find(m.begin(), m.end(), -1) != m.end())
+        throw std::logic_error("finite strain solver: a P2 boundary face without its edge midpoint nodes");
+      facets.push_back({v[0], m[0], m[2]});
+      facets.push_back({m[0], v[1], m[1]});
+      facets.push_back({m[2], m[1], v[2]});
+      facets.push_back({m[0], m[1], m[2]});
+    }
+  // ε_L = ε_N h_min (a line load E h_min costs a penetration h_min / 50 with the automatic ε_N)
+  edge_settings.line_penalty = settings.edge_line_penalty > 0.0 ? settings.edge_line_penalty : penalty * h_min;
+  edge_settings.point_spacing = settings.edge_point_spacing > 0.0 ? settings.edge_point_spacing : 0.25 * h_min;
+  // Facets farther than two boundary edges from an edge point cannot hold its closest point once
+  // the edge has entered the body by less than that in one load increment.
+  edge_settings.search_distance = 2.0 * longest;
+}
+
+void FiniteStrainSolver::Impl::add_blade_edge_contact(const dealii::Vector<double>& state, const LoadState& load,
+                                                      bool with_matrix, Assembly& out,
+                                                      const dealii::AffineConstraints<double>* constraints,
+                                                      dealii::Vector<double>* rhs, dealii::Vector<double>& f_ext) {
+  const BladeEdgeContact c =
+      blade_edge_contact(*tool, load.tool_position, facets, node_positions,
+                         std::span<const double>(state.begin(), state.size()), edge_settings);
+  dealii::FullMatrix<double> term_K(9, 9);
+  dealii::Vector<double> term_f(9);
+  std::vector<dealii::types::global_dof_index> term_dofs(9);
+  for (const EdgeContactTerm& t : c.terms) {
+    for (unsigned i = 0; i < 9; ++i) {
+      term_dofs[i] = 3 * static_cast<dealii::types::global_dof_index>(t.nodes[i / 3]) + i % 3;
+      term_f(i) = t.force_on_body(i);
+      f_ext(term_dofs[i]) += t.force_on_body(i);
+      for (unsigned j = 0; j < 9; ++j) term_K(i, j) = t.stiffness(i, j);
+    }
+    // K += ∂²W/∂x², rhs += f (rhs = f_ext − f_int)
+    if (with_matrix) constraints->distribute_local_to_global(term_K, term_f, term_dofs, K, *rhs);
+  }
+  out.contact_on_body += c.force_on_body;
+  out.edge_points = c.active_points;
+  out.edge_length = c.contact_length;
+  out.max_line_load = c.max_line_load;
+}
+
 void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
                                         Assembly& out, const dealii::AffineConstraints<double>* constraints,
                                         dealii::Vector<double>* rhs) {
@@ -333,6 +429,9 @@ void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, con
   out.contact_points = 0;
   out.contact_area = 0.0;
   out.max_pressure = 0.0;
+  out.edge_points = 0;
+  out.edge_length = 0.0;
+  out.max_line_load = 0.0;
   if (with_matrix) {
     K = 0.0;
     *rhs = 0.0;
@@ -438,6 +537,7 @@ void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, con
       constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
     }
   }
+  if (!facets.empty()) add_blade_edge_contact(state, load, with_matrix, out, constraints, rhs, f_ext);
   out.residual = f_int;
   out.residual -= f_ext;
   out.internal_norm = f_int.l2_norm();
@@ -533,14 +633,21 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
     return fail(std::string("linear solver: ") + e.what());
   }
   // Reactions: the residual on the Dirichlet DOFs is the force the supports put on the body.
-  Eigen::Vector3d support_on_body = Eigen::Vector3d::Zero();
-  for (const auto& d : m.dirichlet) support_on_body[d.component] += assembly.residual[d.index];
-  report.support_reaction = -support_on_body;
+  // The reaction of boundary b is −Σ R over the Dirichlet DOFs assigned to b.
+  report.boundary_reactions.resize(m.boundaries.size());
+  for (std::size_t b = 0; b < m.boundaries.size(); ++b) report.boundary_reactions[b].surface = m.boundaries[b].surface;
+  for (const auto& d : m.dirichlet)
+    report.boundary_reactions[static_cast<std::size_t>(d.boundary)].force[d.component] -= assembly.residual[d.index];
+  for (const BoundaryReaction& b : report.boundary_reactions) report.support_reaction += b.force;
   report.tool_force = -assembly.contact_on_body;
   report.traction_resultant = assembly.traction_on_body;
+  report.force_imbalance = report.traction_resultant - report.tool_force - report.support_reaction;
   report.contact_points = assembly.contact_points;
   report.contact_area = assembly.contact_area;
   report.max_contact_pressure = assembly.max_pressure;
+  report.edge_contact_points = assembly.edge_points;
+  report.edge_contact_length = assembly.edge_length;
+  report.max_edge_line_load = assembly.max_line_load;
   return report;
 }
 

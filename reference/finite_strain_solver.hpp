@@ -91,12 +91,23 @@ struct SolverSettings {
   /// Contact penalty ε_N [Pa/m]; 0 = automatic, 50 E_max / h_min (h_min the shortest edge after
   /// refinement), i.e. a penetration of 2% of an element under a stress of E.
   double contact_penalty = 0.0;
+  /// Blade edge pass (blade_edge_contact.hpp): line penalty ε_L [N/m²]; 0 = automatic, ε_N h_min
+  /// (= 50 E_max with the automatic ε_N).
+  double edge_line_penalty = 0.0;
+  /// Blade edge pass: edge point spacing [m]; 0 = automatic, h_min / 4.
+  double edge_point_spacing = 0.0;
 };
 
 /// The load of one equilibrium solve.
 struct LoadState {
   double load_factor = 0.0;                               ///< scales tractions and prescribed u
   Eigen::Vector3d tool_position = Eigen::Vector3d::Zero(); ///< tool reference point [m]
+};
+
+/// The reaction at one displacement boundary: the force the body puts on that support.
+struct BoundaryReaction {
+  std::string surface;                               ///< the DisplacementBoundary's surface group
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();   ///< body on support [N]: −Σ R_a over its DOFs
 };
 
 /// What one equilibrium solve did and found.
@@ -107,9 +118,19 @@ struct EquilibriumReport {
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();       ///< contact resultant: body on tool [N]
   Eigen::Vector3d support_reaction = Eigen::Vector3d::Zero(); ///< body on its supports [N]
   Eigen::Vector3d traction_resultant = Eigen::Vector3d::Zero(); ///< applied tractions on the body [N]
+  /// One entry per FiniteStrainProblem::displacement_boundaries, in that order. A DOF on two
+  /// boundaries counts for the first bonded/prescribed one (else the first sliding one), so the
+  /// entries sum to `support_reaction`.
+  std::vector<BoundaryReaction> boundary_reactions;
+  /// Global balance of the body: traction_resultant − tool_force − support_reaction [N]; zero at
+  /// equilibrium up to the free-DOF residual (Newton's third law: the body is at rest).
+  Eigen::Vector3d force_imbalance = Eigen::Vector3d::Zero();
   int contact_points = 0;    ///< boundary quadrature points inside the tool
   double contact_area = 0.0; ///< reference area of those points' weights [m^2]
   double max_contact_pressure = 0.0; ///< [Pa]
+  int edge_contact_points = 0;       ///< blade edge points inside the body (blade_edge_contact.hpp)
+  double edge_contact_length = 0.0;  ///< edge length in contact [m]
+  double max_edge_line_load = 0.0;   ///< largest edge line load ε_L d [N/m]
   double assembly_seconds = 0.0;
   double linear_solve_seconds = 0.0;
   int linear_iterations = 0; ///< iterative solver: total CG iterations

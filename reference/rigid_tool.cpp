@@ -25,6 +25,8 @@ void validate(const RigidToolShape& s) {
     throw std::invalid_argument("rigid tool: wedge_angle must lie in (0, pi), got " + std::to_string(s.wedge_angle));
   if (!(s.thickness > 0.0) || !std::isfinite(s.thickness))
     throw std::invalid_argument("rigid tool: wedge thickness must be positive, got " + std::to_string(s.thickness));
+  if (!(s.edge_length > 0.0) || !std::isfinite(s.edge_length))
+    throw std::invalid_argument("rigid tool: wedge edge_length must be positive, got " + std::to_string(s.edge_length));
 }
 
 ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c, const Eigen::Vector3d& x) {
@@ -45,22 +47,25 @@ ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c,
   const Eigen::Vector3d& d = s.cutting_direction;
   const Eigen::Vector3d m = s.edge_direction.cross(d);
   const double phi = 0.5 * s.wedge_angle;
-  const std::array<Eigen::Vector3d, 4> normals{std::sin(phi) * d + std::cos(phi) * m,
-                                               std::sin(phi) * d - std::cos(phi) * m, m, -m};
-  const std::array<double, 4> offsets{0.0, 0.0, 0.5 * s.thickness, 0.5 * s.thickness};
+  const Eigen::Vector3d& e = s.edge_direction;
+  const std::array<Eigen::Vector3d, 6> normals{std::sin(phi) * d + std::cos(phi) * m,
+                                               std::sin(phi) * d - std::cos(phi) * m, m, -m, e, -e};
+  // An edge_length of 0 (a shape that skipped validate) leaves the wedge unbounded along e.
+  const double half_length = s.edge_length > 0.0 ? 0.5 * s.edge_length : std::numeric_limits<double>::infinity();
+  const std::array<double, 6> offsets{0.0, 0.0, 0.5 * s.thickness, 0.5 * s.thickness, half_length, half_length};
   int face = -1;
   double largest = -std::numeric_limits<double>::infinity();
-  for (int k = 0; k < 4; ++k) {
+  for (std::size_t k = 0; k < normals.size(); ++k) {
     const double sk = r.dot(normals[k]) - offsets[k];
     if (sk > largest) {
       largest = sk;
-      face = k;
+      face = static_cast<int>(k);
     }
   }
   if (largest >= 0.0) return out;
   out.inside = true;
   out.penetration = -largest;
-  out.normal = normals[face];
+  out.normal = normals[static_cast<std::size_t>(face)];
   return out;
 }
 

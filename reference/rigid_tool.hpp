@@ -19,6 +19,7 @@ struct RigidToolShape {
   Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ(); ///< wedge: unit d ⟂ e, edge advances along d
   double wedge_angle = 0.0; ///< wedge: included angle θ [rad] in (0, π)
   double thickness = 0.0;   ///< wedge: back thickness t [m] > 0 (the slab behind the flanks)
+  double edge_length = 0.0; ///< wedge: edge length L [m] > 0, centred on the reference point
 };
 
 /// Throws std::invalid_argument naming the field if the shape is not usable (non-positive size,
@@ -38,8 +39,9 @@ struct ToolContactPoint {
 /// Wedge: in the frame (d, m = e × d), the solid is the intersection of the half-spaces
 ///   s₁ = (x−c)·(sin φ d + cos φ m) <= 0,  s₂ = (x−c)·(sin φ d − cos φ m) <= 0 (the flanks, φ = θ/2),
 ///   s₃ = (x−c)·m − t/2 <= 0,               s₄ = −(x−c)·m − t/2 <= 0 (the back slab),
-/// infinite along e and behind the edge; the penetration is −max sₖ and n the normal of the face
-/// attaining it (the nearest exit).
+///   s₅ = (x−c)·e − L/2 <= 0,               s₆ = −(x−c)·e − L/2 <= 0 (the ends of the edge),
+/// infinite behind the edge; the penetration is −max sₖ and n the normal of the face attaining it
+/// (the nearest exit). The edge itself is pressed against the body by blade_edge_contact.hpp.
 ToolContactPoint tool_contact(const RigidToolShape& shape, const Eigen::Vector3d& position, const Eigen::Vector3d& x);
 
 } // namespace kerf::reference

@@ -1,11 +1,14 @@
-// kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [-o DIR] [--resume] [--no-fields]:
-// the finite-strain reference along the scene's trajectory (issue 3), written as profile.csv +
-// manifest.json (+ fields.pvd), with a progress line per sample and checkpoints to resume from.
+// kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [--until T] [--levels L] [-o DIR]
+// [--resume] [--no-fields]: the finite-strain reference along the scene's trajectory (issue 3),
+// written as profile.csv + manifest.json (+ fields.pvd), with a progress line per sample and
+// checkpoints to resume from; with --levels, a mesh convergence study over L refinements.
 
 #include "experiments/cli/commands.hpp"
+#include "experiments/run/reference_convergence.hpp"
 #include "experiments/run/reference_run.hpp"
 #include "experiments/run/session_replay.hpp"
 #include "experiments/run/scene_mesh.hpp"
+#include "experiments/scene/quantity.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"
@@ -24,6 +27,9 @@ struct ReferenceOptions {
   int degree = 1;
   int refine = 0;
   int samples = 0; ///< 0 = every trajectory sample
+  double until = -1.0; ///< < 0: the whole trajectory; else only samples with t <= until [s]
+  int levels = 0;      ///< 0: one run; >= 3: a convergence study over that many refinements
+  std::string element_size; ///< overrides the scene's element size ("5 mm"); empty = the scene's
   bool resume = false;
   bool no_fields = false;
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
@@ -34,19 +40,40 @@ void run_reference_command(const ReferenceOptions& o) {
   const Scene read = read_scene(resolve_scene(o.scene));
   const fs::path out = o.out.empty() ? fs::path("runs") / read.name / "reference" : fs::path(o.out);
   // A recorded session replays what the hand did at the rig through the ground truth.
-  const Scene scene = o.trajectory.empty() ? read : replay_session(read, o.trajectory, out);
+  Scene scene = o.trajectory.empty() ? read : replay_session(read, o.trajectory, out);
+  if (!o.element_size.empty()) scene.geometry.element_size = parse_quantity(o.element_size, Dimension::length);
   ReferenceRunSettings settings;
   settings.degree = o.degree;
   settings.refinements = o.refine;
   settings.write_fields = !o.no_fields;
   settings.resume = o.resume;
   if (o.samples < 0) throw std::invalid_argument("--samples must be >= 1, got " + std::to_string(o.samples));
-  if (o.samples > 0) {
+  if (o.samples > 0 || o.until >= 0.0) {
     if (scene.tools.empty()) throw std::invalid_argument("scene '" + scene.name + "' has no tool");
-    settings.sample_indices = reference_sample_indices(sample(scene.tools.front().trajectory).samples.size(), o.samples);
+    const SampledTrajectory path = sample(scene.tools.front().trajectory);
+    // Samples are in time order: the first `count` have t <= until.
+    std::size_t count = path.samples.size();
+    if (o.until >= 0.0) {
+      count = 0;
+      while (count < path.samples.size() && path.samples[count].time <= o.until + 1e-12) ++count;
+      if (count == 0) throw std::invalid_argument("--until " + std::to_string(o.until) + " s is before the first sample");
+    }
+    if (o.samples > 0) {
+      settings.sample_indices = reference_sample_indices(count, o.samples);
+    } else {
+      for (std::size_t k = 0; k < count; ++k) settings.sample_indices.push_back(k);
+    }
   }
   const auto begin = std::chrono::steady_clock::now();
   const TetMesh mesh = scene_mesh(scene);
+  if (o.levels > 0) {
+    if (o.resume) throw std::invalid_argument("--resume does not apply to a convergence study (--levels)");
+    const fs::path dir = o.out.empty() ? fs::path("runs") / read.name / "reference_convergence" : fs::path(o.out);
+    const ConvergenceStudy study = run_reference_convergence(scene, mesh, settings, o.levels, dir);
+    std::printf("%s", convergence_markdown(scene, study).c_str());
+    std::printf("wrote %s, %s\n", (dir / "convergence.csv").c_str(), (dir / "convergence.md").c_str());
+    return;
+  }
   const ForceProfile profile = run_reference(scene, mesh, settings, out);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   double peak = 0.0;
@@ -68,6 +95,14 @@ void add_reference_command(CLI::App& app) {
   cmd->add_option("--samples", options->samples,
                   "solve N evenly spaced trajectory samples, first and last included (default: every sample)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--until", options->until, "solve only trajectory samples with t <= T seconds")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--levels", options->levels,
+                  "mesh convergence: run at L successive refinements (from --refine) into DIR/refine_K and "
+                  "report the observed order (DIR default runs/SCENE/reference_convergence)")
+      ->check(CLI::Range(3, 5));
+  cmd->add_option("--element-size", options->element_size,
+                  "mesh the scene with this element size instead of its own (a length, e.g. \"5 mm\")");
   cmd->add_option("-o,--output", options->out, "output directory (default runs/SCENE/reference)");
   cmd->add_flag("--resume", options->resume, "continue from DIR/checkpoint.bin");
   cmd->add_flag("--no-fields", options->no_fields, "do not write fields.pvd and the .vtu files");

@@ -81,6 +81,7 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh) {
     shape.cutting_direction = tool.blade.cutting_direction;
     shape.wedge_angle = tool.blade.wedge_angle;
     shape.thickness = tool.blade.thickness;
+    shape.edge_length = tool.blade.edge_length;
     p.tool = shape;
     return out;
   }
@@ -344,20 +345,6 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   solver_settings.degree = settings.degree;
   solver_settings.refinements = settings.refinements;
   reference::FiniteStrainSolver solver(rp.problem, solver_settings);
-  // The reaction on the tied nodes: a second solver on the same mesh whose only Dirichlet DOFs
-  // are the tie, given the converged state and asked for equilibrium with no Newton step and an
-  // unbounded tolerance. Its "support reaction" (−Σ of the residual over its Dirichlet DOFs) is then
-  // the force of the body on the tied nodes, i.e. on the stylus.
-  std::unique_ptr<reference::FiniteStrainSolver> tie_probe;
-  if (tied) {
-    FiniteStrainProblem probe = rp.problem;
-    probe.displacement_boundaries.erase(probe.displacement_boundaries.begin(),
-                                        probe.displacement_boundaries.end() - 1); // keep the tie (last)
-    reference::SolverSettings probe_settings = solver_settings;
-    probe_settings.max_newton_iterations = 0;
-    probe_settings.relative_tolerance = 1e300;
-    tie_probe = std::make_unique<reference::FiniteStrainSolver>(probe, probe_settings);
-  }
 
   const std::string sha = file_sha256(scene.file);
   const fs::path checkpoint_file = dir / "checkpoint.bin";
@@ -406,22 +393,23 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     }
     Eigen::Vector3d tool_force = step.tool_force + Eigen::Vector3d::Zero(); // −0 → 0
     Eigen::Vector3d support = step.support_reaction;
-    double cost = step.seconds;
+    const double cost = step.seconds;
+    nlohmann::json reactions = nlohmann::json::object();
+    for (const reference::BoundaryReaction& b : step.equilibrium.boundary_reactions)
+      reactions[b.surface] = vec_json(b.force + Eigen::Vector3d::Zero());
     if (tied) {
-      const auto t0 = Clock::now();
-      tie_probe->set_state(path.last_converged_state());
-      const reference::EquilibriumReport r = tie_probe->solve(load);
-      if (!r.converged) throw std::runtime_error("reference: evaluating the stylus reaction failed: " + r.failure);
-      tool_force = r.support_reaction + Eigen::Vector3d::Zero(); // + 0 turns −0 into 0 in the CSV
-      support = step.support_reaction - tool_force; // the main solver sums every Dirichlet DOF
-      cost += std::chrono::duration<double>(Clock::now() - t0).count();
+      // The stylus tie is the last displacement boundary (reference_problem): the force of the
+      // body on the tied nodes is the force on the stylus; the supports carry the rest.
+      tool_force = step.equilibrium.boundary_reactions.back().force + Eigen::Vector3d::Zero(); // + 0: −0 → 0
+      support = step.support_reaction - tool_force;
     }
     ProfileRow row;
     row.t = rp.times[k];
     row.tool = tool_name;
     row.position = rp.positions[k];
     row.force = tool_force;
-    const bool touching = tied ? tool_force.norm() > 0.0 : step.equilibrium.contact_points > 0;
+    const bool touching = tied ? tool_force.norm() > 0.0
+                               : step.equilibrium.contact_points + step.equilibrium.edge_contact_points > 0;
     row.mode = touching ? InteractionMode::deformation_1 : InteractionMode::no_contact;
     row.cost_s = cost;
     cp.profile.rows.push_back(row);
@@ -434,7 +422,11 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                           {"seconds", cost},
                           {"tool_force_N", vec_json(tool_force)},
                           {"support_reaction_N", vec_json(support)},
-                          {"contact_points", step.equilibrium.contact_points}});
+                          {"boundary_reactions_N", reactions},
+                          {"force_imbalance_N", vec_json(step.equilibrium.force_imbalance)},
+                          {"contact_points", step.equilibrium.contact_points},
+                          {"edge_contact_points", step.equilibrium.edge_contact_points},
+                          {"edge_contact_length_m", step.equilibrium.edge_contact_length}});
     cp.solve_seconds += cost;
     newton_total += step.newton_iterations;
     cp.solved = i + 1;
