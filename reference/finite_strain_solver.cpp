@@ -1,5 +1,11 @@
 // The deal.II side of the finite-strain reference (finite_strain_solver.hpp): triangulation from
 // TetMesh, FE space, total-Lagrangian assembly, penalty contact, Newton with line search, output.
+//
+// One Newton, line search and assembly for two linear algebras: SerialAlgebra (deal.II Vector and
+// SparseMatrix, UMFPACK or PETSc CG on this process alone) and DistributedAlgebra (the mesh
+// distributed over the MPI processes as a parallel::fullydistributed::Triangulation, PETSc MPI
+// vectors and matrix, MUMPS or CG + GAMG on MPI_COMM_WORLD). Each process assembles its locally
+// owned cells; norms, contact resultants and reactions are summed over the processes.
 
 #include "reference/finite_strain_solver.hpp"
 
@@ -7,20 +13,29 @@
 #include "reference/material/finite_strain_error.hpp"
 #include "reference/material/neo_hookean.hpp"
 #include "reference/material/st_venant_kirchhoff.hpp"
+#include "reference/mpi_processes.hpp"
 #include "reference/tangent_solver.hpp"
+#include "meshes/atomic_file.hpp"
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/fully_distributed_tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_fe.h>
+#include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria.h>
+#include <deal.II/grid/tria_description.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/petsc_sparse_matrix.h>
+#include <deal.II/lac/petsc_vector.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/lac/vector.h>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
@@ -33,7 +48,9 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <climits>
 #include <map>
+#include <span>
 #include <stdexcept>
 
 namespace kerf::reference {
@@ -63,12 +80,53 @@ std::unique_ptr<HyperelasticLaw> make_law(const MaterialRegion& region) {
   throw std::invalid_argument("finite strain solver: unknown material law");
 }
 
+/// The linear algebra of one process alone: deal.II's serial vector and sparse matrix.
+struct SerialAlgebra {
+  using VectorType = dealii::Vector<double>;
+  using MatrixType = dealii::SparseMatrix<double>;
+  std::size_t n = 0;
+  dealii::SparsityPattern pattern;
+  MatrixType K;
+  VectorType u;         ///< the displacement DOFs
+  VectorType free_mask; ///< 1 on free DOFs, 0 on Dirichlet DOFs
+  void reinit(VectorType& v) const { v.reinit(n); }
+  /// The vector with the values every cell of this process reads: itself.
+  const VectorType& ghosted(const VectorType& v) const { return v; }
+  [[nodiscard]] bool owns(dealii::types::global_dof_index) const { return true; }
+  void prepare(dealii::AffineConstraints<double>&) const {}
+};
+
+/// The linear algebra of the distributed mesh: PETSc MPI vectors and matrix over the locally
+/// owned DOFs of this process, ghosted copies for the locally relevant ones.
+struct DistributedAlgebra {
+  using VectorType = dealii::PETScWrappers::MPI::Vector;
+  using MatrixType = dealii::PETScWrappers::MPI::SparseMatrix;
+  MPI_Comm comm = MPI_COMM_WORLD;
+  dealii::IndexSet owned, relevant;
+  MatrixType K;
+  VectorType u;
+  VectorType free_mask;
+  mutable VectorType ghost; ///< locally relevant values of the last vector passed to ghosted()
+  void reinit(VectorType& v) const { v.reinit(owned, comm); }
+  /// `v` (locally owned values) with the ghost values of the locally relevant DOFs (collective).
+  const VectorType& ghosted(const VectorType& v) const {
+    ghost = v;
+    return ghost;
+  }
+  [[nodiscard]] bool owns(dealii::types::global_dof_index i) const { return owned.is_element(i); }
+  void prepare(dealii::AffineConstraints<double>& c) const { c.reinit(relevant); }
+};
+
 } // namespace
 
 struct FiniteStrainSolver::Impl {
   SolverSettings settings;
   std::vector<std::string> surface_names;
-  dealii::Triangulation<3> tria;
+  dealii::Triangulation<3> tria; // the whole mesh, on every process (refined before distribution)
+  bool distributed = false;      // the mesh is distributed over MPI_COMM_WORLD's processes
+  int process_count = 1;
+  int rank = 0;
+  std::unique_ptr<dealii::parallel::fullydistributed::Triangulation<3>> distributed_tria;
   std::unique_ptr<dealii::FESystem<3>> fe;
   std::unique_ptr<dealii::MappingFE<3>> mapping;
   dealii::DoFHandler<3> dof;
@@ -95,14 +153,29 @@ struct FiniteStrainSolver::Impl {
   std::optional<RigidToolShape> tool;
   double penalty = 0.0;
 
-  dealii::SparsityPattern pattern;
-  dealii::SparseMatrix<double> K;
-  dealii::Vector<double> u;
+  SerialAlgebra serial;
+  // Only when distributed: PETSc objects need PETSc (and MPI) initialised, which a serial run never does.
+  std::unique_ptr<DistributedAlgebra> parallel;
   std::unique_ptr<TangentSolver> linear;
 
+  /// Calls f with the algebra in use (the distributed one when the mesh is distributed).
+  template <class F> decltype(auto) with_algebra(F&& f) { return distributed ? f(*parallel) : f(serial); }
+  template <class F> decltype(auto) with_algebra(F&& f) const {
+    return distributed ? f(static_cast<const DistributedAlgebra&>(*parallel)) : f(serial);
+  }
+
+  /// Sums over the processes (in place) when distributed.
+  void sum(std::span<double> values) const {
+    if (distributed && !values.empty())
+      dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(values.data(), values.size()), parallel->comm,
+                                  dealii::ArrayView<double>(values.data(), values.size()));
+  }
+  double sum(double value) const { return distributed ? dealii::Utilities::MPI::sum(value, parallel->comm) : value; }
+  double max(double value) const { return distributed ? dealii::Utilities::MPI::max(value, parallel->comm) : value; }
+
   // Result of one assembly.
-  struct Assembly {
-    dealii::Vector<double> residual; // f_int − f_ext − f_contact, all DOFs
+  template <class VectorType> struct Assembly {
+    VectorType residual; // f_int − f_ext − f_contact, all DOFs
     double internal_norm = 0.0;      // |f_int|
     double external_norm = 0.0;      // |f_ext + f_contact|
     Eigen::Vector3d contact_on_body = Eigen::Vector3d::Zero();
@@ -119,11 +192,23 @@ struct FiniteStrainSolver::Impl {
   }
 
   void build(const FiniteStrainProblem& problem);
-  void assemble(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix, Assembly& out,
-                const dealii::AffineConstraints<double>* constraints, dealii::Vector<double>* rhs);
-  double free_norm(const dealii::Vector<double>& r) const {
-    dealii::Vector<double> copy = r;
-    for (const auto& d : dirichlet) copy[d.index] = 0.0;
+  template <class Algebra>
+  void assemble(Algebra& la, const typename Algebra::VectorType& owned_state, const LoadState& load, bool with_matrix,
+                Assembly<typename Algebra::VectorType>& out, const dealii::AffineConstraints<double>* constraints,
+                typename Algebra::VectorType* rhs);
+  /// The cell loop of `assemble`: this process's cells into K, rhs, f_int, f_ext and the tallies.
+  template <class VectorType, class MatrixType, class Tally>
+  void assemble_cells(const VectorType& state, const LoadState& load, bool with_matrix, Tally& out,
+                      const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
+                      VectorType& f_int, VectorType& f_ext) const;
+  template <class Algebra> EquilibriumReport solve(Algebra& la, const LoadState& load);
+  /// The fields of the displacement `u` (locally relevant values) to `file` (see write_fields).
+  template <class VectorType>
+  void write_fields(const VectorType& u, const std::filesystem::path& file, const LoadState& load) const;
+  /// |r| over the free DOFs (the Dirichlet entries masked out).
+  template <class VectorType> double free_norm(const VectorType& r, const VectorType& mask) const {
+    VectorType copy = r;
+    copy.scale(mask);
     return copy.l2_norm();
   }
 };
@@ -204,6 +289,24 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     }
   if (settings.refinements > 0) tria.refine_global(static_cast<unsigned>(settings.refinements));
 
+  // Under mpirun with N > 1 processes: METIS splits the (refined) mesh into N parts and each
+  // process keeps its part plus a layer of ghost cells (deal.II's tests/simplex/step-40 way;
+  // a fully distributed triangulation cannot be refined afterwards).
+  if (settings.distribute) {
+    const MpiProcesses processes = mpi_processes();
+    distributed = processes.count > 1;
+    process_count = processes.count;
+    rank = processes.rank;
+  }
+  if (distributed) {
+    parallel = std::make_unique<DistributedAlgebra>();
+    dealii::GridTools::partition_triangulation(static_cast<unsigned>(process_count), tria);
+    const auto description =
+        dealii::TriangulationDescription::Utilities::create_description_from_triangulation(tria, parallel->comm);
+    distributed_tria = std::make_unique<dealii::parallel::fullydistributed::Triangulation<3>>(parallel->comm);
+    distributed_tria->create_triangulation(description);
+  }
+
   auto group_of = [&](const std::string& name, const char* what) {
     for (std::size_t g = 0; g < surface_names.size(); ++g)
       if (surface_names[g] == name) return static_cast<int>(g);
@@ -215,7 +318,10 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   mapping = std::make_unique<dealii::MappingFE<3>>(dealii::FE_SimplexP<3>(1));
   cell_quadrature = std::make_unique<dealii::QGaussSimplex<3>>(static_cast<unsigned>(settings.degree + 1));
   face_quadrature = std::make_unique<dealii::QGaussSimplex<2>>(static_cast<unsigned>(settings.degree + 1));
-  dof.reinit(tria);
+  if (distributed)
+    dof.reinit(*distributed_tria);
+  else
+    dof.reinit(tria);
   dof.distribute_dofs(*fe);
 
   // Support points; the node-major layout (3k + component) the AMG's block size relies on.
@@ -224,6 +330,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     std::vector<dealii::types::global_dof_index> local(fe->n_dofs_per_cell());
     const auto& unit_points = fe->get_unit_support_points();
     for (const auto& cell : dof.active_cell_iterators()) {
+      if (cell->is_artificial()) continue; // distributed: neither owned nor ghost
       cell->get_dof_indices(local);
       for (unsigned i = 0; i < local.size(); ++i) {
         support[local[i]] = mapping->transform_unit_to_real_cell(cell, unit_points[i]);
@@ -269,6 +376,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
       std::vector<dealii::types::global_dof_index> local(fe->n_dofs_per_face());
       for (const auto& cell : dof.active_cell_iterators())
         for (const unsigned f : cell->face_indices()) {
+          if (cell->is_artificial()) break;
           if (!cell->face(f)->at_boundary() || !in_group(cell->face(f)->boundary_id(), group)) continue;
           cell->face(f)->get_dof_indices(local);
           for (unsigned i = 0; i < local.size(); ++i) {
@@ -286,10 +394,11 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     dealii::FEFaceValues<3> fv(*mapping, *fe, *face_quadrature, dealii::update_JxW_values);
     for (const auto& cell : dof.active_cell_iterators())
       for (const unsigned f : cell->face_indices())
-        if (cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), group)) {
+        if (cell->is_locally_owned() && cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), group)) {
           fv.reinit(cell, f);
           for (unsigned q = 0; q < fv.n_quadrature_points; ++q) area += fv.JxW(q);
         }
+    area = sum(area);
     if (!(area > 0.0)) throw std::invalid_argument("finite strain solver: traction surface '" + t.surface + "' has no area");
     tractions.emplace_back(group, t.total_force / area);
   }
@@ -307,36 +416,112 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     }
   }
 
-  dealii::AffineConstraints<double> structure;
-  for (const auto& d : dirichlet) structure.add_line(d.index);
-  structure.close();
-  dealii::DynamicSparsityPattern dsp(dof.n_dofs());
-  dealii::DoFTools::make_sparsity_pattern(dof, dsp, structure, false);
-  pattern.copy_from(dsp);
-  K.reinit(pattern);
-  u.reinit(dof.n_dofs());
-
   const bool direct = settings.linear_solver == LinearSolverChoice::direct ||
                       (settings.linear_solver == LinearSolverChoice::automatic && dof.n_dofs() <= settings.direct_dof_limit);
-  linear = std::make_unique<TangentSolver>(direct ? TangentSolver::Kind::direct : TangentSolver::Kind::iterative,
-                                           std::move(support), settings.iterative_tolerance);
+  const auto kind = direct ? TangentSolver::Kind::direct : TangentSolver::Kind::iterative;
+  if (!distributed) {
+    dealii::AffineConstraints<double> structure;
+    for (const auto& d : dirichlet) structure.add_line(d.index);
+    structure.close();
+    dealii::DynamicSparsityPattern dsp(dof.n_dofs());
+    dealii::DoFTools::make_sparsity_pattern(dof, dsp, structure, false);
+    serial.n = dof.n_dofs();
+    serial.pattern.copy_from(dsp);
+    serial.K.reinit(serial.pattern);
+    serial.u.reinit(dof.n_dofs());
+    serial.free_mask.reinit(dof.n_dofs());
+    serial.free_mask = 1.0;
+    for (const auto& d : dirichlet) serial.free_mask[d.index] = 0.0;
+    linear = std::make_unique<TangentSolver>(kind, std::move(support), settings.iterative_tolerance);
+    return;
+  }
+  // Distributed: this process's rows (locally owned DOFs) and the DOFs its cells touch
+  // (locally relevant: owned and ghost cells); the sparsity rows other processes contribute to
+  // are sent to their owners.
+  DistributedAlgebra& la = *parallel;
+  la.owned = dof.locally_owned_dofs();
+  dealii::DoFTools::extract_locally_relevant_dofs(dof, la.relevant);
+  if (!la.owned.is_contiguous())
+    throw std::logic_error("finite strain solver: the locally owned DOFs are not one contiguous range");
+  dealii::AffineConstraints<double> structure(la.relevant);
+  for (const auto& d : dirichlet) structure.add_line(d.index);
+  structure.close();
+  dealii::DynamicSparsityPattern dsp(la.relevant);
+  dealii::DoFTools::make_sparsity_pattern(dof, dsp, structure, false);
+  dealii::SparsityTools::distribute_sparsity_pattern(dsp, la.owned, la.comm, la.relevant);
+  la.K.reinit(la.owned, la.owned, dsp, la.comm);
+  la.reinit(la.u);
+  la.ghost.reinit(la.owned, la.relevant, la.comm);
+  la.reinit(la.free_mask);
+  la.free_mask = 1.0;
+  std::vector<dealii::types::global_dof_index> fixed_owned;
+  for (const auto& d : dirichlet)
+    if (la.owns(d.index)) fixed_owned.push_back(d.index);
+  la.free_mask.set(fixed_owned, std::vector<double>(fixed_owned.size(), 0.0));
+  la.free_mask.compress(dealii::VectorOperation::insert);
+  std::vector<dealii::Point<3>> owned_support;
+  for (const auto i : la.owned) owned_support.push_back(support[i]);
+  linear = std::make_unique<TangentSolver>(kind, std::move(owned_support), settings.iterative_tolerance, true);
 }
 
-void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
-                                        Assembly& out, const dealii::AffineConstraints<double>* constraints,
-                                        dealii::Vector<double>* rhs) {
-  const unsigned n = fe->n_dofs_per_cell();
-  out.residual.reinit(dof.n_dofs());
-  dealii::Vector<double> f_int(dof.n_dofs()), f_ext(dof.n_dofs());
+template <class Algebra>
+void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::VectorType& owned_state,
+                                        const LoadState& load, bool with_matrix,
+                                        Assembly<typename Algebra::VectorType>& out,
+                                        const dealii::AffineConstraints<double>* constraints,
+                                        typename Algebra::VectorType* rhs) {
+  typename Algebra::VectorType f_int, f_ext;
+  la.reinit(f_int);
+  la.reinit(f_ext);
+  la.reinit(out.residual);
   out.contact_on_body.setZero();
   out.traction_on_body.setZero();
   out.contact_points = 0;
   out.contact_area = 0.0;
   out.max_pressure = 0.0;
   if (with_matrix) {
-    K = 0.0;
+    la.K = 0.0;
     *rhs = 0.0;
   }
+  // An element that fails on one process fails the assembly on every process (after the
+  // collective compress), so that all of them take the same branch of Newton and line search.
+  std::string failure;
+  try {
+    assemble_cells(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_int, f_ext);
+  } catch (const FiniteStrainError& e) {
+    failure = e.what();
+  }
+  if (with_matrix) {
+    la.K.compress(dealii::VectorOperation::add);
+    rhs->compress(dealii::VectorOperation::add);
+  }
+  f_int.compress(dealii::VectorOperation::add);
+  f_ext.compress(dealii::VectorOperation::add);
+  if (max(failure.empty() ? 0.0 : 1.0) > 0.0)
+    throw FiniteStrainError(failure.empty() ? "finite strain: an element of another process failed" : failure);
+  // The contact and traction tallies of every process's cells.
+  std::array<double, 8> tally{out.contact_on_body.x(), out.contact_on_body.y(), out.contact_on_body.z(),
+                              out.traction_on_body.x(), out.traction_on_body.y(), out.traction_on_body.z(),
+                              static_cast<double>(out.contact_points), out.contact_area};
+  sum(tally);
+  out.contact_on_body = Eigen::Vector3d(tally[0], tally[1], tally[2]);
+  out.traction_on_body = Eigen::Vector3d(tally[3], tally[4], tally[5]);
+  out.contact_points = static_cast<int>(tally[6]);
+  out.contact_area = tally[7];
+  out.max_pressure = max(out.max_pressure);
+  out.residual = f_int;
+  out.residual -= f_ext;
+  out.internal_norm = f_int.l2_norm();
+  out.external_norm = f_ext.l2_norm();
+  if (!std::isfinite(out.residual.l2_norm())) throw FiniteStrainError("finite strain: non-finite residual");
+}
+
+template <class VectorType, class MatrixType, class Tally>
+void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const LoadState& load, bool with_matrix,
+                                              Tally& out, const dealii::AffineConstraints<double>* constraints,
+                                              MatrixType& K, VectorType* rhs, VectorType& f_int,
+                                              VectorType& f_ext) const {
+  const unsigned n = fe->n_dofs_per_cell();
   dealii::FEValues<3> fv(*mapping, *fe, *cell_quadrature,
                          dealii::update_gradients | dealii::update_JxW_values);
   dealii::FEFaceValues<3> ffv(*mapping, *fe, *face_quadrature,
@@ -353,6 +538,7 @@ void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, con
   std::vector<Eigen::Matrix<double, 9, 1>> AgradN(n);
 
   for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue; // distributed: another process assembles it
     fv.reinit(cell);
     cell->get_dof_indices(local);
     cell_K = 0.0;
@@ -429,20 +615,13 @@ void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, con
         }
       }
     }
-    for (unsigned i = 0; i < n; ++i) {
-      f_int(local[i]) += cell_int(i);
-      f_ext(local[i]) += cell_ext(i);
-    }
+    f_int.add(local, cell_int);
+    f_ext.add(local, cell_ext);
     if (with_matrix) {
       for (unsigned i = 0; i < n; ++i) cell_rhs(i) = cell_ext(i) - cell_int(i);
       constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
     }
   }
-  out.residual = f_int;
-  out.residual -= f_ext;
-  out.internal_norm = f_int.l2_norm();
-  out.external_norm = f_ext.l2_norm();
-  if (!std::isfinite(out.residual.l2_norm())) throw FiniteStrainError("finite strain: non-finite residual");
 }
 
 FiniteStrainSolver::FiniteStrainSolver(const FiniteStrainProblem& problem, const SolverSettings& settings)
@@ -454,13 +633,20 @@ FiniteStrainSolver::FiniteStrainSolver(const FiniteStrainProblem& problem, const
 FiniteStrainSolver::~FiniteStrainSolver() = default;
 
 EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
-  Impl& m = *m_impl;
+  return m_impl->with_algebra([&](auto& la) { return m_impl->solve(la, load); });
+}
+
+template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algebra& la, const LoadState& load) {
+  using VectorType = typename Algebra::VectorType;
+  Impl& m = *this;
   EquilibriumReport report;
-  const dealii::Vector<double> start = m.u;
-  Impl::Assembly assembly;
-  dealii::Vector<double> rhs(m.dof.n_dofs()), du(m.dof.n_dofs());
+  const VectorType start = la.u;
+  Impl::Assembly<VectorType> assembly;
+  VectorType rhs, du;
+  la.reinit(rhs);
+  la.reinit(du);
   auto fail = [&](std::string why) {
-    m.u = start;
+    la.u = start;
     report.converged = false;
     report.failure = std::move(why);
     return report;
@@ -469,22 +655,25 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
     for (int it = 0;; ++it) {
       // Constraints of this iteration: the remaining Dirichlet increment target − u.
       dealii::AffineConstraints<double> constraints;
+      la.prepare(constraints);
+      const VectorType& u_relevant = la.ghosted(la.u);
       double mismatch = 0.0;
       for (const auto& d : m.dirichlet) {
-        const double g = m.dirichlet_target(d, load.load_factor) - m.u[d.index];
+        const double g = m.dirichlet_target(d, load.load_factor) - u_relevant[d.index];
         mismatch = std::max(mismatch, std::abs(g));
         constraints.add_line(d.index);
         constraints.set_inhomogeneity(d.index, g);
       }
       constraints.close();
+      mismatch = m.max(mismatch);
       auto t0 = Clock::now();
-      m.assemble(m.u, load, true, assembly, &constraints, &rhs);
+      m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
       report.assembly_seconds += seconds_since(t0);
-      const double r = m.free_norm(assembly.residual);
+      const double r = m.free_norm(assembly.residual, la.free_mask);
       report.residual_history.push_back(r);
       const double scale = assembly.internal_norm + assembly.external_norm;
       const double tol = m.settings.relative_tolerance * scale + m.settings.absolute_tolerance;
-      const double u_scale = std::max(m.u.linfty_norm(), 1e-300);
+      const double u_scale = std::max(la.u.linfty_norm(), 1e-300);
       if (r <= tol && mismatch <= 1e-12 * u_scale + 1e-300) {
         report.converged = true;
         break;
@@ -492,7 +681,7 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
       if (it >= m.settings.max_newton_iterations)
         return fail("no convergence in " + std::to_string(m.settings.max_newton_iterations) + " Newton iterations");
       t0 = Clock::now();
-      report.linear_iterations += m.linear->solve(m.K, du, rhs);
+      report.linear_iterations += m.linear->solve(la.K, du, rhs);
       report.linear_solve_seconds += seconds_since(t0);
       constraints.distribute(du);
       ++report.newton_iterations;
@@ -500,20 +689,20 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
       // every element valid and reduces |R|, else the valid α with the smallest |R|. While a
       // Dirichlet increment is pending the residual is no merit function (it starts at zero and
       // must grow with the imposed displacement): then the largest valid α is taken.
-      const dealii::Vector<double> base = m.u;
+      const VectorType base = la.u;
       double best_alpha = 0.0, best_r = std::numeric_limits<double>::infinity();
-      Impl::Assembly trial;
+      Impl::Assembly<VectorType> trial;
       for (double alpha = 1.0; alpha > 1.0 / 64.0; alpha *= 0.5) {
-        m.u = base;
-        m.u.add(alpha, du);
+        la.u = base;
+        la.u.add(alpha, du);
         try {
           t0 = Clock::now();
-          m.assemble(m.u, load, false, trial, nullptr, nullptr);
+          m.assemble(la, la.u, load, false, trial, nullptr, nullptr);
           report.assembly_seconds += seconds_since(t0);
         } catch (const FiniteStrainError&) {
           continue;
         }
-        const double rt = m.free_norm(trial.residual);
+        const double rt = m.free_norm(trial.residual, la.free_mask);
         if (rt < best_r) {
           best_r = rt;
           best_alpha = alpha;
@@ -524,8 +713,8 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
         }
       }
       if (best_alpha == 0.0) return fail("every line-search step inverts an element");
-      m.u = base;
-      m.u.add(best_alpha, du);
+      la.u = base;
+      la.u.add(best_alpha, du);
     }
   } catch (const FiniteStrainError& e) {
     return fail(e.what());
@@ -534,7 +723,9 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
   }
   // Reactions: the residual on the Dirichlet DOFs is the force the supports put on the body.
   Eigen::Vector3d support_on_body = Eigen::Vector3d::Zero();
-  for (const auto& d : m.dirichlet) support_on_body[d.component] += assembly.residual[d.index];
+  for (const auto& d : m.dirichlet)
+    if (la.owns(d.index)) support_on_body[d.component] += assembly.residual[d.index];
+  m.sum(std::span<double>(support_on_body.data(), 3));
   report.support_reaction = -support_on_body;
   report.tool_force = -assembly.contact_on_body;
   report.traction_resultant = assembly.traction_on_body;
@@ -550,31 +741,45 @@ std::string FiniteStrainSolver::linear_solver_name() const { return m_impl->line
 double FiniteStrainSolver::contact_penalty() const { return m_impl->penalty; }
 double FiniteStrainSolver::max_displacement() const {
   double best = 0.0;
-  const auto& u = m_impl->u;
+  const std::vector<double> u = state();
   for (std::size_t k = 0; k + 2 < u.size(); k += 3)
     best = std::max(best, std::sqrt(u[k] * u[k] + u[k + 1] * u[k + 1] + u[k + 2] * u[k + 2]));
   return best;
 }
 
+int FiniteStrainSolver::process_count() const { return m_impl->distributed ? m_impl->process_count : 1; }
+
 Eigen::Vector3d FiniteStrainSolver::displacement_at(const Eigen::Vector3d& X) const {
   const Impl& m = *m_impl;
-  // The cell whose barycentric coordinates of X are all >= −tol (straight-sided tetrahedra).
-  for (const auto& cell : m.dof.active_cell_iterators()) {
-    Eigen::Matrix3d A;
-    const Eigen::Vector3d v0 = to_eigen(cell->vertex(0));
-    for (unsigned k = 1; k < 4; ++k) A.col(k - 1) = to_eigen(cell->vertex(k)) - v0;
-    const Eigen::Vector3d xi = A.lu().solve(X - v0);
-    const double tol = 1e-10;
-    if (xi.minCoeff() < -tol || xi.sum() > 1.0 + tol) continue;
-    // The unit tetrahedron's vertices 1, 2, 3 are e_x, e_y, e_z: the unit point is ξ itself.
-    const dealii::Quadrature<3> point(dealii::Point<3>(xi[0], xi[1], xi[2]));
-    dealii::FEValues<3> fv(*m.mapping, *m.fe, point, dealii::update_values);
-    fv.reinit(cell);
-    std::vector<dealii::Vector<double>> value(1, dealii::Vector<double>(3));
-    fv.get_function_values(m.u, value);
-    return {value[0][0], value[0][1], value[0][2]};
-  }
-  throw std::out_of_range("displacement_at: the point lies outside the mesh");
+  std::optional<Eigen::Vector3d> found;
+  m.with_algebra([&](const auto& la) {
+    const auto& u = la.ghosted(la.u);
+    // The cell whose barycentric coordinates of X are all >= −tol (straight-sided tetrahedra).
+    for (const auto& cell : m.dof.active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      Eigen::Matrix3d A;
+      const Eigen::Vector3d v0 = to_eigen(cell->vertex(0));
+      for (unsigned k = 1; k < 4; ++k) A.col(k - 1) = to_eigen(cell->vertex(k)) - v0;
+      const Eigen::Vector3d xi = A.lu().solve(X - v0);
+      const double tol = 1e-10;
+      if (xi.minCoeff() < -tol || xi.sum() > 1.0 + tol) continue;
+      // The unit tetrahedron's vertices 1, 2, 3 are e_x, e_y, e_z: the unit point is ξ itself.
+      const dealii::Quadrature<3> point(dealii::Point<3>(xi[0], xi[1], xi[2]));
+      dealii::FEValues<3> fv(*m.mapping, *m.fe, point, dealii::update_values);
+      fv.reinit(cell);
+      std::vector<dealii::Vector<double>> value(1, dealii::Vector<double>(3));
+      fv.get_function_values(u, value);
+      found = Eigen::Vector3d(value[0][0], value[0][1], value[0][2]);
+      return;
+    }
+  });
+  // Distributed: the lowest rank whose cells hold X answers.
+  const double owner = -m.max(found ? -static_cast<double>(m.rank) : -static_cast<double>(INT_MAX));
+  if (owner == static_cast<double>(INT_MAX))
+    throw std::out_of_range("displacement_at: the point lies outside the mesh");
+  Eigen::Vector3d value = found && owner == static_cast<double>(m.rank) ? *found : Eigen::Vector3d::Zero();
+  m.sum(std::span<double>(value.data(), 3));
+  return value;
 }
 
 std::vector<Eigen::Matrix3d> FiniteStrainSolver::quadrature_cauchy_stresses() const {
@@ -582,26 +787,50 @@ std::vector<Eigen::Matrix3d> FiniteStrainSolver::quadrature_cauchy_stresses() co
   std::vector<Eigen::Matrix3d> out;
   dealii::FEValues<3> fv(*m.mapping, *m.fe, *m.cell_quadrature, dealii::update_gradients);
   std::vector<dealii::Tensor<2, 3>> grads(m.cell_quadrature->size());
-  for (const auto& cell : m.dof.active_cell_iterators()) {
-    fv.reinit(cell);
-    fv[dealii::FEValuesExtractors::Vector(0)].get_function_gradients(m.u, grads);
-    for (const auto& g : grads) {
-      const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(g);
-      out.push_back(cauchy_stress(F, m.laws[cell->material_id()]->stress_and_tangent(F).first_piola));
+  m.with_algebra([&](const auto& la) {
+    const auto& u = la.ghosted(la.u);
+    for (const auto& cell : m.dof.active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      fv.reinit(cell);
+      fv[dealii::FEValuesExtractors::Vector(0)].get_function_gradients(u, grads);
+      for (const auto& g : grads) {
+        const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(g);
+        out.push_back(cauchy_stress(F, m.laws[cell->material_id()]->stress_and_tangent(F).first_piola));
+      }
     }
-  }
+  });
   return out;
 }
 
 std::vector<double> FiniteStrainSolver::state() const {
-  return std::vector<double>(m_impl->u.begin(), m_impl->u.end());
+  const Impl& m = *m_impl;
+  if (!m.distributed) return std::vector<double>(m.serial.u.begin(), m.serial.u.end());
+  // Every process's locally owned values in place, summed over the processes.
+  const DistributedAlgebra& la = *m.parallel;
+  std::vector<dealii::types::global_dof_index> indices(la.owned.begin(), la.owned.end());
+  std::vector<double> values(indices.size());
+  la.u.extract_subvector_to(indices, values);
+  std::vector<double> all(m.dof.n_dofs(), 0.0);
+  for (std::size_t k = 0; k < indices.size(); ++k) all[indices[k]] = values[k];
+  m.sum(all);
+  return all;
 }
 
 void FiniteStrainSolver::set_state(const std::vector<double>& values) {
-  if (values.size() != m_impl->u.size())
+  Impl& m = *m_impl;
+  if (values.size() != m.dof.n_dofs())
     throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values for " +
-                                std::to_string(m_impl->u.size()) + " DOFs");
-  std::copy(values.begin(), values.end(), m_impl->u.begin());
+                                std::to_string(m.dof.n_dofs()) + " DOFs");
+  if (!m.distributed) {
+    std::copy(values.begin(), values.end(), m.serial.u.begin());
+    return;
+  }
+  DistributedAlgebra& la = *m.parallel;
+  std::vector<dealii::types::global_dof_index> indices(la.owned.begin(), la.owned.end());
+  std::vector<double> owned(indices.size());
+  for (std::size_t k = 0; k < indices.size(); ++k) owned[k] = values[indices[k]];
+  la.u.set(indices, owned);
+  la.u.compress(dealii::VectorOperation::insert);
 }
 
 namespace {
@@ -639,19 +868,27 @@ private:
 
 } // namespace
 
-void FiniteStrainSolver::write_fields(const std::filesystem::path& vtu, const LoadState& load) const {
+void FiniteStrainSolver::write_fields(const std::filesystem::path& file, const LoadState& load) const {
   const Impl& m = *m_impl;
+  m.with_algebra([&](const auto& la) { m.write_fields(la.ghosted(la.u), file, load); });
+}
+
+template <class VectorType>
+void FiniteStrainSolver::Impl::write_fields(const VectorType& u, const std::filesystem::path& file,
+                                            const LoadState& load) const {
+  const Impl& m = *this;
+  const unsigned cells = m.dof.get_triangulation().n_active_cells(); // distributed: this process's view
   // Contact pressure per cell: the largest ε_N p over the cell's boundary quadrature points.
-  dealii::Vector<float> pressure(m.tria.n_active_cells()), material(m.tria.n_active_cells());
+  dealii::Vector<float> pressure(cells), material(cells);
   if (m.tool) {
     dealii::FEFaceValues<3> ffv(*m.mapping, *m.fe, *m.face_quadrature,
                                 dealii::update_values | dealii::update_quadrature_points);
     std::vector<dealii::Tensor<1, 3>> face_u(m.face_quadrature->size());
     for (const auto& cell : m.dof.active_cell_iterators())
       for (const unsigned f : cell->face_indices()) {
-        if (!cell->face(f)->at_boundary()) continue;
+        if (!cell->is_locally_owned() || !cell->face(f)->at_boundary()) continue;
         ffv.reinit(cell, f);
-        ffv[dealii::FEValuesExtractors::Vector(0)].get_function_values(m.u, face_u);
+        ffv[dealii::FEValuesExtractors::Vector(0)].get_function_values(u, face_u);
         for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
           const Eigen::Vector3d x =
               to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
@@ -662,7 +899,7 @@ void FiniteStrainSolver::write_fields(const std::filesystem::path& vtu, const Lo
         }
       }
   }
-  for (const auto& cell : m.tria.active_cell_iterators())
+  for (const auto& cell : m.dof.active_cell_iterators())
     material[cell->active_cell_index()] = static_cast<float>(cell->material_id());
   StressPostprocessor stress(m.laws);
   dealii::DataOut<3> out;
@@ -670,15 +907,37 @@ void FiniteStrainSolver::write_fields(const std::filesystem::path& vtu, const Lo
   const std::vector<std::string> names(3, "displacement");
   const std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> kinds(
       3, dealii::DataComponentInterpretation::component_is_part_of_vector);
-  out.add_data_vector(m.u, names, dealii::DataOut<3>::type_dof_data, kinds);
-  out.add_data_vector(m.u, stress);
+  out.add_data_vector(u, names, dealii::DataOut<3>::type_dof_data, kinds);
+  out.add_data_vector(u, stress);
   out.add_data_vector(pressure, "contact_pressure", dealii::DataOut<3>::type_cell_data);
   out.add_data_vector(material, "material_id", dealii::DataOut<3>::type_cell_data);
   // Quadratic output cells without write_higher_order_cells (dealii-on-debian12.md, "output").
+  // (Distributed: DataOut takes this process's locally owned cells.)
   out.build_patches(*m.mapping, static_cast<unsigned>(m.settings.degree));
-  std::ofstream file(vtu);
-  if (!file) throw std::runtime_error("write_fields: cannot open " + vtu.string());
-  out.write_vtu(file);
+  if (!m.distributed) {
+    std::ofstream stream(file);
+    if (!stream) throw std::runtime_error("write_fields: cannot open " + file.string());
+    out.write_vtu(stream);
+    return;
+  }
+  // One .vtu piece per process beside the .pvtu record that lists them (written by rank 0 after
+  // every piece is in place), each atomically.
+  auto piece = [&](int rank) { return file.stem().string() + "." + std::to_string(rank) + ".vtu"; };
+  auto write = [](const std::filesystem::path& target, const std::function<void(std::ostream&)>& body) {
+    write_atomically(target, [&](const std::filesystem::path& tmp) {
+      std::ofstream stream(tmp);
+      if (!stream) throw std::runtime_error("write_fields: cannot open " + tmp.string());
+      body(stream);
+      stream.flush();
+      if (!stream) throw std::runtime_error("write_fields: writing " + tmp.string() + " failed");
+    });
+  };
+  write(file.parent_path() / piece(rank), [&](std::ostream& stream) { out.write_vtu(stream); });
+  MPI_Barrier(parallel->comm);
+  if (rank != 0) return;
+  std::vector<std::string> pieces;
+  for (int r = 0; r < process_count; ++r) pieces.push_back(piece(r));
+  write(file, [&](std::ostream& stream) { out.write_pvtu_record(stream, pieces); });
 }
 
 } // namespace kerf::reference

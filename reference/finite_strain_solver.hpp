@@ -5,9 +5,15 @@
 // tractions and a rigid tool in penalty contact. In the spirit of deal.II's step-44 and the code
 // gallery's "Quasi-Static Finite-Strain Compressible Elasticity", written for tetrahedra.
 //
+// Under `mpirun -np N` (N > 1) the solver is distributed: the mesh is split over the N processes
+// (parallel::fullydistributed::Triangulation), PETSc MPI vectors and matrix, MUMPS or CG + GAMG;
+// every member function is then collective (all processes call it, in the same order) and
+// returns the same global values on every process unless its comment says otherwise. Started
+// on its own, the program solves serially (deal.II vectors, UMFPACK) without initialising MPI.
+//
 // This header is plain data + pimpl: it includes no deal.II or PETSc, so the rest of kerf compiles
-// without them (the only translation units that include deal.II are finite_strain_solver.cpp,
-// tangent_solver.cpp and field_output.cpp in this folder).
+// without them (the only translation units that include deal.II are finite_strain_solver.cpp and
+// tangent_solver.cpp in this folder; mpi_processes.cpp includes PETSc).
 
 #include "meshes/tet_mesh.hpp"
 #include "reference/rigid_tool.hpp"
@@ -74,7 +80,7 @@ struct FiniteStrainProblem {
 /// Linear solver for each Newton step.
 enum class LinearSolverChoice {
   automatic, ///< direct up to SolverSettings::direct_dof_limit DOFs, iterative above
-  direct,    ///< UMFPACK (deal.II SparseDirectUMFPACK) on an optimised BLAS
+  direct,    ///< UMFPACK (deal.II SparseDirectUMFPACK) on an optimised BLAS; distributed: MUMPS
   iterative  ///< PETSc CG + GAMG with the rigid-body near null space; unpreconditioned-norm stop
 };
 
@@ -91,6 +97,9 @@ struct SolverSettings {
   /// Contact penalty ε_N [Pa/m]; 0 = automatic, 50 E_max / h_min (h_min the shortest edge after
   /// refinement), i.e. a penetration of 2% of an element under a stress of E.
   double contact_penalty = 0.0;
+  /// Launched by mpirun with N > 1 processes: distribute the mesh over them (true), or solve the
+  /// whole problem on this process alone (false, e.g. a serial comparison inside an MPI job).
+  bool distribute = true;
 };
 
 /// The load of one equilibrium solve.
@@ -136,27 +145,34 @@ public:
 
   [[nodiscard]] std::size_t dof_count() const;
   [[nodiscard]] std::size_t cell_count() const;
-  /// "umfpack" or "petsc-cg-gamg": what `solve` uses for this problem size and settings.
+  /// "umfpack", "mumps" (distributed direct) or "petsc-cg-gamg": what `solve` uses.
   [[nodiscard]] std::string linear_solver_name() const;
   /// The contact penalty in use [Pa/m].
   [[nodiscard]] double contact_penalty() const;
+  /// The number of MPI processes the mesh is distributed over (1: serial).
+  [[nodiscard]] int process_count() const;
 
   /// Displacement [m] at reference point X (evaluated in the tetrahedron containing X). Throws
   /// std::out_of_range if X lies outside the mesh.
   [[nodiscard]] Eigen::Vector3d displacement_at(const Eigen::Vector3d& X) const;
-  /// Cauchy stress [Pa] at every cell quadrature point of the current state.
+  /// Cauchy stress [Pa] at every cell quadrature point of the current state (distributed: of this
+  /// process's locally owned cells only).
   [[nodiscard]] std::vector<Eigen::Matrix3d> quadrature_cauchy_stresses() const;
   /// Largest displacement magnitude over the DOFs [m].
   [[nodiscard]] double max_displacement() const;
 
-  /// The state for a checkpoint: the DOF values of the displacement.
+  /// The state for a checkpoint: the DOF values of the displacement, all of them in global DOF
+  /// order on every process (distributed: gathered; the numbering depends on the process count,
+  /// so a state is restored with the same number of processes).
   [[nodiscard]] std::vector<double> state() const;
   /// Restores a checkpointed state. Throws std::invalid_argument on a size mismatch.
   void set_state(const std::vector<double>& values);
 
-  /// Writes the current fields to `vtu` (displacement; J, Cauchy stress, von Mises per point;
-  /// contact pressure and material id per cell) with the tool at `load.tool_position`.
-  void write_fields(const std::filesystem::path& vtu, const LoadState& load) const;
+  /// Writes the current fields (displacement; J, Cauchy stress, von Mises per point; contact
+  /// pressure and material id per cell) with the tool at `load.tool_position` to `file`: a .vtu
+  /// when serial; distributed, `file` is a .pvtu record (written by rank 0) listing one .vtu piece
+  /// per process, `<stem>.<rank>.vtu` beside it, each file written atomically.
+  void write_fields(const std::filesystem::path& file, const LoadState& load) const;
 
   struct Impl;
 

@@ -1,6 +1,8 @@
-// kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [-o DIR] [--resume] [--no-fields]:
-// the finite-strain reference along the scene's trajectory (issue 3), written as profile.csv +
-// manifest.json (+ fields.pvd), with a progress line per sample and checkpoints to resume from.
+// kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [-o DIR] [--resume] [--no-fields]
+// [--solver auto|direct|iterative] [--np N]: the finite-strain reference along the scene's
+// trajectory (issue 3), written as profile.csv + manifest.json (+ fields.pvd), with a progress
+// line per sample and checkpoints to resume from. `--np N` re-launches the same command under
+// `mpirun -np N` (as `mpirun -np N kerf reference …` does directly): the solver runs distributed.
 
 #include "experiments/cli/commands.hpp"
 #include "experiments/run/reference_run.hpp"
@@ -9,10 +11,20 @@
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"
+#include "reference/mpi_processes.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
 #include <memory>
+#include <stdexcept>
+#include <thread>
+#include <vector>
 
 namespace kerf::cli {
 
@@ -27,10 +39,48 @@ struct ReferenceOptions {
   bool resume = false;
   bool no_fields = false;
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
+  reference::LinearSolverChoice solver = reference::LinearSolverChoice::automatic;
+  int np = 0; ///< MPI processes; 0 = this process alone (or as many as mpirun started)
 };
+
+/// Replaces this process by `mpirun -np N <this program> reference …` with the same options
+/// (--oversubscribe when N exceeds the cores; as root, Open MPI's OMPI_ALLOW_RUN_AS_ROOT[_CONFIRM]
+/// set, without which it refuses to start). Returns only by throwing.
+[[noreturn]] void relaunch_under_mpirun(const ReferenceOptions& o) {
+  const std::string program = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::vector<std::string> args{"mpirun", "-np", std::to_string(o.np)};
+  if (static_cast<unsigned>(o.np) > std::thread::hardware_concurrency()) args.emplace_back("--oversubscribe");
+  args.insert(args.end(), {program, "reference", o.scene, "--degree", std::to_string(o.degree), "--refine",
+                           std::to_string(o.refine)});
+  if (o.samples > 0) args.insert(args.end(), {"--samples", std::to_string(o.samples)});
+  if (!o.out.empty()) args.insert(args.end(), {"-o", o.out});
+  if (o.resume) args.emplace_back("--resume");
+  if (o.no_fields) args.emplace_back("--no-fields");
+  if (!o.trajectory.empty()) args.insert(args.end(), {"--trajectory", o.trajectory});
+  const char* solver = o.solver == reference::LinearSolverChoice::direct      ? "direct"
+                       : o.solver == reference::LinearSolverChoice::iterative ? "iterative"
+                                                                               : "auto";
+  args.insert(args.end(), {"--solver", solver});
+  if (::geteuid() == 0) {
+    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+  }
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  ::execvp("mpirun", argv.data());
+  throw std::runtime_error(std::string("--np ") + std::to_string(o.np) + ": cannot run mpirun: " + std::strerror(errno));
+}
 
 void run_reference_command(const ReferenceOptions& o) {
   namespace fs = std::filesystem;
+  const int launched = reference::mpirun_process_count();
+  if (o.np > 1 && launched == 0) relaunch_under_mpirun(o);
+  if (o.np > 0 && launched > 0 && o.np != launched)
+    throw std::invalid_argument("--np " + std::to_string(o.np) + " but mpirun started " + std::to_string(launched) +
+                                " processes");
   const Scene read = read_scene(resolve_scene(o.scene));
   const fs::path out = o.out.empty() ? fs::path("runs") / read.name / "reference" : fs::path(o.out);
   // A recorded session replays what the hand did at the rig through the ground truth.
@@ -40,6 +90,7 @@ void run_reference_command(const ReferenceOptions& o) {
   settings.refinements = o.refine;
   settings.write_fields = !o.no_fields;
   settings.resume = o.resume;
+  settings.linear_solver = o.solver;
   if (o.samples < 0) throw std::invalid_argument("--samples must be >= 1, got " + std::to_string(o.samples));
   if (o.samples > 0) {
     if (scene.tools.empty()) throw std::invalid_argument("scene '" + scene.name + "' has no tool");
@@ -49,6 +100,7 @@ void run_reference_command(const ReferenceOptions& o) {
   const TetMesh mesh = scene_mesh(scene);
   const ForceProfile profile = run_reference(scene, mesh, settings, out);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (reference::mpi_processes().rank != 0) return; // rank 0 reports
   double peak = 0.0;
   for (const ProfileRow& r : profile.rows) peak = std::max(peak, r.force.norm());
   std::printf("%s / reference (P%d, %d refinements): %zu samples solved, peak |F| %.6g N, wall %.2f s\n",
@@ -71,6 +123,17 @@ void add_reference_command(CLI::App& app) {
   cmd->add_option("-o,--output", options->out, "output directory (default runs/SCENE/reference)");
   cmd->add_flag("--resume", options->resume, "continue from DIR/checkpoint.bin");
   cmd->add_flag("--no-fields", options->no_fields, "do not write fields.pvd and the .vtu files");
+  const std::map<std::string, reference::LinearSolverChoice> solvers{
+      {"auto", reference::LinearSolverChoice::automatic},
+      {"direct", reference::LinearSolverChoice::direct},
+      {"iterative", reference::LinearSolverChoice::iterative}};
+  cmd->add_option("--solver", options->solver,
+                  "linear solver: auto (direct up to 60000 DOFs), direct (UMFPACK; MUMPS under MPI) or iterative "
+                  "(PETSc CG + GAMG)")
+      ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case));
+  cmd->add_option("--np", options->np,
+                  "run distributed on N MPI processes: re-launches this command under mpirun -np N")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--trajectory", options->trajectory,
                   "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   cmd->callback([options] { run_reference_command(*options); });
