@@ -26,6 +26,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <thread>
@@ -97,6 +98,20 @@ FaultRun run_through_link(ToolModel& model, const test::LinkFaults& faults, doub
   out.link = link.log();
   out.device = emulator.received();
   out.session = read_session(file);
+  // What the run did, for docs/reliability.md (not asserted here).
+  const LinkCounters& c = out.report.links.front();
+  const SafetyCounters& f = out.report.safety.front();
+  std::printf("[ measured ] %s: %zu ticks; link sent %llu states, dropped %zu, duplicated %llu, reordered %llu, "
+              "truncated %llu, stalls %llu; rig accepted %llu, lost %llu, duplicated %llu, stale %llu, malformed %llu; "
+              "safety: watchdog %llu, non-finite %llu, clamped %llu ticks\n",
+              name.c_str(), out.session.ticks.size(), static_cast<unsigned long long>(out.link.states),
+              out.link.dropped.size(), static_cast<unsigned long long>(out.link.duplicated),
+              static_cast<unsigned long long>(out.link.reordered), static_cast<unsigned long long>(out.link.truncated),
+              static_cast<unsigned long long>(out.link.stalls), static_cast<unsigned long long>(c.accepted),
+              static_cast<unsigned long long>(c.lost), static_cast<unsigned long long>(c.duplicated),
+              static_cast<unsigned long long>(c.stale), static_cast<unsigned long long>(c.malformed),
+              static_cast<unsigned long long>(f.watchdog), static_cast<unsigned long long>(f.non_finite),
+              static_cast<unsigned long long>(f.clamped));
   return out;
 }
 
@@ -138,7 +153,7 @@ void expect_drops_counted(double probability, unsigned seed) {
   test::LinkFaults faults;
   faults.drop = probability;
   faults.seed = seed;
-  const FaultRun r = run_through_link(model, faults, 1.5, "drop.csv");
+  const FaultRun r = run_through_link(model, faults, 1.5, "drop_" + std::to_string(static_cast<int>(probability * 100)) + ".csv");
   const double largest = expect_safe(r);
   EXPECT_GT(largest, 1.0) << "the spring's 2 N never reached the device: the test could not fail";
   const LinkCounters& c = r.report.links.front();
