@@ -113,6 +113,7 @@ struct FiniteStrainSolver::Impl {
   std::vector<unsigned> cell_components;      // component of each local DOF of a cell
   double cohesive_viscous_dissipation = 0.0;
   double committed_time = 0.0;
+  bool cohesive_secant = false; // Newton fallback: the secant interface tangent (cohesive_law.hpp)
   void build_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group);
   Eigen::Vector3d cohesive_opening(const CohesivePair& pair, std::size_t q, const dealii::Vector<double>& state) const;
   void assemble_cohesive(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
@@ -595,7 +596,8 @@ void FiniteStrainSolver::Impl::assemble_cohesive(const dealii::Vector<double>& s
     local_rhs = 0.0;
     for (std::size_t q = 0; q < nq; ++q) {
       const CohesiveResponse r =
-          cohesive_response(*cohesive_law, cohesive_states[p * nq + q], cohesive_opening(pair, q, state), pair.normal, dt);
+          cohesive_response(*cohesive_law, cohesive_states[p * nq + q], cohesive_opening(pair, q, state), pair.normal, dt,
+                            cohesive_secant);
       const double w = pair.weights[q];
       for (std::size_t i = 0; i < n; ++i) {
         a[i] = pair.plus_values[q][i];
@@ -672,6 +674,10 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
         constraints.set_inhomogeneity(d.index, g);
       }
       constraints.close();
+      // A cohesive interface whose points switch between loading and unloading can make the
+      // consistent Newton iteration cycle; after a third of the allowed iterations the secant
+      // interface tangent takes over (slower, but it does not cycle).
+      m.cohesive_secant = m.cohesive_law && it >= m.settings.max_newton_iterations / 3;
       auto t0 = Clock::now();
       m.assemble(m.u, load, true, assembly, &constraints, &rhs);
       report.assembly_seconds += seconds_since(t0);

@@ -7,6 +7,7 @@
 // Includes reference/*.hpp only, which include no deal.II.
 
 #include "experiments/profile/force_profile.hpp"
+#include "experiments/run/reference_fracture.hpp"
 #include "experiments/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "reference/finite_strain_solver.hpp"
@@ -29,6 +30,8 @@ struct ReferenceRunSettings {
   bool write_fields = true; ///< dir/fields.pvd + dir/fields/step_NNNN.vtu
   int checkpoint_every = 5; ///< write dir/checkpoint.bin after every this many solved samples (>= 1)
   bool resume = false;      ///< continue from dir/checkpoint.bin if it exists
+  /// Cohesive fracture along the scene's cut_plane (Reference II; reference_fracture.hpp).
+  ReferenceFracture fracture = ReferenceFracture::automatic;
 };
 
 /// How the scene's tool is coupled to the body in the reference.

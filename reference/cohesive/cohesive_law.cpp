@@ -36,7 +36,7 @@ double cohesive_dissipation(const CohesiveLawParameters& p, double kappa) {
 }
 
 CohesiveResponse cohesive_response(const CohesiveLawParameters& p, const CohesiveState& state, const Eigen::Vector3d& opening,
-                                   const Eigen::Vector3d& n, double dt) {
+                                   const Eigen::Vector3d& n, double dt, bool secant_tangent) {
   const double d0 = p.peak_opening(), df = p.failure_opening(), k0 = p.initial_stiffness();
   const double beta2 = p.shear_weight * p.shear_weight;
   const Eigen::Matrix3d nn = n * n.transpose();
@@ -60,7 +60,7 @@ CohesiveResponse cohesive_response(const CohesiveLawParameters& p, const Cohesiv
   Eigen::Matrix3d m = beta2 * (Eigen::Matrix3d::Identity() - nn);
   if (dn > 0.0) m += nn;
   r.tangent = secant * m;
-  if (loading && d < df) {
+  if (loading && d < df && !secant_tangent) {
     // On the envelope t = (T(δ)/δ) q with dδ = q·dΔ/δ, so ∂t/∂Δ = (T/δ) M + (T'δ − T)/δ³ q qᵀ,
     // T' = −σ_c/(δ_f − δ_0) on the softening branch (the rising branch is only reached with δ <= δ_0,
     // which is never "loading" here).

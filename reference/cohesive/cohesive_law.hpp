@@ -72,8 +72,13 @@ struct CohesiveResponse {
 /// Evaluates the law at opening `opening` with unit normal `normal` (pointing from − into +),
 /// history `state` and time step `dt` [s] (used by the viscous term only; dt <= 0 switches it off).
 /// Pure: the caller commits `damage_opening` and the opening to the state when the step converges.
+/// `secant_tangent` returns the secant K(κ) M (positive semi-definite, dropping the softening term)
+/// instead of the consistent tangent: the robust fallback of a Newton iteration that cycles
+/// between loading and unloading states (the "secant stiffness" iteration, e.g. de Borst et al.
+/// 2012, Non-Linear Finite Element Analysis of Solids and Structures, §6.2).
 CohesiveResponse cohesive_response(const CohesiveLawParameters& parameters, const CohesiveState& state,
-                                   const Eigen::Vector3d& opening, const Eigen::Vector3d& normal, double dt);
+                                   const Eigen::Vector3d& opening, const Eigen::Vector3d& normal, double dt,
+                                   bool secant_tangent = false);
 
 /// The envelope T(δ) [Pa] and its dissipated energy φ_d(κ) [J/m^2] (closed forms of the bilinear law).
 double cohesive_envelope(const CohesiveLawParameters& parameters, double effective_opening);
