@@ -382,6 +382,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                " is from a different run (scene file, degree, refinements or samples differ)");
     solver.set_state(saved.state);
     cp = std::move(saved);
+    cp.last.time = cp.last.load_factor * T; // the load factor is t/T (load_of), also between samples
     resumed_from = cp.solved;
     std::fprintf(stderr, "reference %s: resuming after sample %zu/%zu from %s\n", scene.name.c_str(), cp.solved,
                  indices.size(), checkpoint_file.c_str());

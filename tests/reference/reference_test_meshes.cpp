@@ -139,19 +139,4 @@ void add_interior_face_group(TetMesh& mesh, const std::string& name, const std::
   mesh.surface_groups.push_back(std::move(group));
 }
 
-void add_sub_group(TetMesh& mesh, const std::string& from, const std::string& name,
-                   const std::function<bool(const Eigen::Vector3d&)>& select) {
-  const SurfaceGroup* source = mesh.find_surface_group(from);
-  if (source == nullptr) throw std::invalid_argument("add_sub_group: no surface group '" + from + "'");
-  std::vector<Eigen::Index> rows;
-  for (Eigen::Index f = 0; f < source->triangles.rows(); ++f) {
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (int j = 0; j < 3; ++j) centroid += mesh.nodes.row(source->triangles(f, j)).transpose() / 3.0;
-    if (select(centroid)) rows.push_back(f);
-  }
-  SurfaceGroup group{name, static_cast<int>(mesh.surface_groups.size()) + 100, Eigen::MatrixXi(static_cast<Eigen::Index>(rows.size()), 3)};
-  for (std::size_t r = 0; r < rows.size(); ++r) group.triangles.row(static_cast<Eigen::Index>(r)) = source->triangles.row(rows[r]);
-  mesh.surface_groups.push_back(std::move(group));
-}
-
 } // namespace kerf::reference::test

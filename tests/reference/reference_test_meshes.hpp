@@ -32,9 +32,4 @@ TetMesh cook_membrane(int n);
 /// all satisfy `on_surface`, e.g. a grid plane of a box mesh to be split into a crack path.
 void add_interior_face_group(TetMesh& mesh, const std::string& name, const std::function<bool(const Eigen::Vector3d&)>& on_surface);
 
-/// Adds the surface group `name`: the triangles of surface group `from` whose centroid satisfies
-/// `select` (e.g. the upper half of an end face).
-void add_sub_group(TetMesh& mesh, const std::string& from, const std::string& name,
-                   const std::function<bool(const Eigen::Vector3d&)>& select);
-
 } // namespace kerf::reference::test
