@@ -156,6 +156,34 @@ struct FiniteStrainSolver::Impl {
   SerialAlgebra serial;
   // Only when distributed: PETSc objects need PETSc (and MPI) initialised, which a serial run never does.
   std::unique_ptr<DistributedAlgebra> parallel;
+
+  // Cohesive interface (Reference II): coincident face pairs of the split crack path, with each
+  // side's shape values cached at the + face's quadrature points (the reference configuration
+  // does not change), and one history per quadrature point.
+  struct CohesivePair {
+    std::vector<dealii::types::global_dof_index> dofs; // the + cell's n DOFs, then the − cell's n
+    std::vector<std::vector<double>> plus_values;      // [q][i]: N_i of the + cell (component comp[i])
+    std::vector<std::vector<double>> minus_values;     // [q][j]: N_j of the − cell
+    std::vector<double> weights;                       // reference area weights JxW
+    std::vector<Eigen::Vector3d> points;               // reference positions
+    std::array<Eigen::Vector3d, 3> vertices;           // the face's reference vertices
+    Eigen::Vector3d normal;                            // n, from − into + (reference)
+  };
+  std::optional<CohesiveLawParameters> cohesive_law;
+  std::vector<CohesivePair> cohesive_pairs;
+  std::vector<CohesiveState> cohesive_states; // pair-major, then quadrature point
+  std::vector<unsigned> cell_components;      // component of each local DOF of a cell
+  double cohesive_viscous_dissipation = 0.0;
+  double committed_time = 0.0;
+  bool cohesive_secant = false; // Newton fallback: the secant interface tangent (cohesive_law.hpp)
+  void build_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group);
+  template <class VectorType>
+  Eigen::Vector3d cohesive_opening(const CohesivePair& pair, std::size_t q, const VectorType& state) const;
+  template <class VectorType, class MatrixType>
+  void assemble_cohesive(const VectorType& state, const LoadState& load, bool with_matrix,
+                         const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
+                         VectorType& f_int) const;
+  CohesiveSummary commit_cohesive(const LoadState& load);
   std::unique_ptr<TangentSolver> linear;
 
   /// Calls f with the algebra in use (the distributed one when the mesh is distributed).
@@ -416,6 +444,14 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     }
   }
 
+  if (problem.cohesive) {
+    if (distributed)
+      throw std::invalid_argument("finite strain solver: the cohesive interface runs on one process for now "
+                                  "(run without mpirun, or with -np 1)");
+    build_cohesive(*problem.cohesive, group_of(problem.cohesive->plus_surface, "cohesive"),
+                   group_of(problem.cohesive->minus_surface, "cohesive"));
+  }
+
   const bool direct = settings.linear_solver == LinearSolverChoice::direct ||
                       (settings.linear_solver == LinearSolverChoice::automatic && dof.n_dofs() <= settings.direct_dof_limit);
   const auto kind = direct ? TangentSolver::Kind::direct : TangentSolver::Kind::iterative;
@@ -425,6 +461,10 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     structure.close();
     dealii::DynamicSparsityPattern dsp(dof.n_dofs());
     dealii::DoFTools::make_sparsity_pattern(dof, dsp, structure, false);
+    for (const CohesivePair& pair : cohesive_pairs) // the interface couples the two cells' DOFs
+      for (const auto i : pair.dofs)
+        for (const auto j : pair.dofs)
+          if (!structure.is_constrained(i) && !structure.is_constrained(j)) dsp.add(i, j);
     serial.n = dof.n_dofs();
     serial.pattern.copy_from(dsp);
     serial.K.reinit(serial.pattern);
@@ -622,6 +662,172 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
       constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
     }
   }
+  if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);
+}
+
+void FiniteStrainSolver::Impl::build_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group) {
+  validate(spec.law);
+  if (spec.plus_surface == spec.minus_surface)
+    throw std::invalid_argument("finite strain solver: cohesive plus and minus surfaces are the same group '" + spec.plus_surface + "'");
+  const unsigned n = fe->n_dofs_per_cell();
+  cell_components.resize(n);
+  for (unsigned i = 0; i < n; ++i) cell_components[i] = fe->system_to_component_index(i).first;
+
+  // Coincident faces are found by their vertex positions, rounded on a grid far finer than any
+  // element (the copies made by the crack split, and their refinements, coincide exactly).
+  double h_min = std::numeric_limits<double>::infinity();
+  for (const auto& cell : tria.active_cell_iterators())
+    for (unsigned l = 0; l < cell->n_lines(); ++l) h_min = std::min(h_min, cell->line(l)->diameter());
+  const double grid = 1e-6 * h_min;
+  using Key = std::array<long long, 9>;
+  auto key_of = [&](const auto& face) {
+    std::array<std::array<long long, 3>, 3> v{};
+    for (unsigned k = 0; k < 3; ++k)
+      for (unsigned c = 0; c < 3; ++c) v[k][c] = std::llround(face->vertex(k)[c] / grid);
+    std::sort(v.begin(), v.end());
+    Key key{};
+    for (unsigned k = 0; k < 3; ++k)
+      for (unsigned c = 0; c < 3; ++c) key[3 * k + c] = v[k][c];
+    return key;
+  };
+  std::map<Key, dealii::DoFHandler<3>::active_cell_iterator> minus_faces;
+  for (const auto& cell : dof.active_cell_iterators())
+    for (const unsigned f : cell->face_indices())
+      if (cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), minus_group)) minus_faces[key_of(cell->face(f))] = cell;
+
+  dealii::FEFaceValues<3> ffv(*mapping, *fe, *face_quadrature,
+                              dealii::update_values | dealii::update_quadrature_points | dealii::update_JxW_values |
+                                  dealii::update_normal_vectors);
+  std::vector<dealii::types::global_dof_index> plus_dofs(n), minus_dofs(n);
+  for (const auto& cell : dof.active_cell_iterators())
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary() || !in_group(cell->face(f)->boundary_id(), plus_group)) continue;
+      const auto match = minus_faces.find(key_of(cell->face(f)));
+      if (match == minus_faces.end())
+        throw std::invalid_argument("finite strain solver: a face of cohesive surface '" + spec.plus_surface + "' at (" +
+                                    std::to_string(cell->face(f)->center()[0]) + ", " + std::to_string(cell->face(f)->center()[1]) +
+                                    ", " + std::to_string(cell->face(f)->center()[2]) + ") m has no coincident face in '" +
+                                    spec.minus_surface + "' (was the mesh split along the crack path?)");
+      const auto minus_cell = match->second;
+      ffv.reinit(cell, f);
+      CohesivePair pair;
+      cell->get_dof_indices(plus_dofs);
+      minus_cell->get_dof_indices(minus_dofs);
+      pair.dofs = plus_dofs;
+      pair.dofs.insert(pair.dofs.end(), minus_dofs.begin(), minus_dofs.end());
+      // The + cell's outward normal points into the − side; n points from − into +.
+      pair.normal = -Eigen::Vector3d(ffv.normal_vector(0)[0], ffv.normal_vector(0)[1], ffv.normal_vector(0)[2]);
+      for (unsigned k = 0; k < 3; ++k) pair.vertices[k] = to_eigen(cell->face(f)->vertex(k));
+      // The − cell's unit coordinates of each quadrature point (affine P1 geometry: ξ = A⁻¹ (x − v₀),
+      // the unit tetrahedron's vertices 1, 2, 3 being e_x, e_y, e_z).
+      Eigen::Matrix3d A;
+      const Eigen::Vector3d v0 = to_eigen(minus_cell->vertex(0));
+      for (unsigned k = 1; k < 4; ++k) A.col(k - 1) = to_eigen(minus_cell->vertex(k)) - v0;
+      const Eigen::Matrix3d A_inv = A.inverse();
+      for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
+        const Eigen::Vector3d x = to_eigen(ffv.quadrature_point(q));
+        const Eigen::Vector3d xi = A_inv * (x - v0);
+        const dealii::Point<3> unit(xi[0], xi[1], xi[2]);
+        std::vector<double> plus(n), minus(n);
+        for (unsigned i = 0; i < n; ++i) {
+          plus[i] = ffv.shape_value_component(i, q, cell_components[i]);
+          minus[i] = fe->shape_value_component(i, unit, cell_components[i]);
+        }
+        pair.plus_values.push_back(std::move(plus));
+        pair.minus_values.push_back(std::move(minus));
+        pair.weights.push_back(ffv.JxW(q));
+        pair.points.push_back(x);
+      }
+      cohesive_pairs.push_back(std::move(pair));
+    }
+  if (cohesive_pairs.empty())
+    throw std::invalid_argument("finite strain solver: cohesive surface '" + spec.plus_surface + "' has no boundary faces");
+  if (cohesive_pairs.size() != minus_faces.size())
+    throw std::invalid_argument("finite strain solver: cohesive surfaces '" + spec.plus_surface + "' and '" + spec.minus_surface +
+                                "' have different face counts (" + std::to_string(cohesive_pairs.size()) + " and " +
+                                std::to_string(minus_faces.size()) + ")");
+  cohesive_law = spec.law;
+  cohesive_states.assign(cohesive_pairs.size() * face_quadrature->size(), CohesiveState{});
+}
+
+template <class VectorType>
+Eigen::Vector3d FiniteStrainSolver::Impl::cohesive_opening(const CohesivePair& pair, std::size_t q,
+                                                          const VectorType& state) const {
+  // Δ = x⁺ − x⁻ = u⁺ − u⁻ at a point where the two faces coincide in the reference configuration.
+  const std::size_t n = cell_components.size();
+  Eigen::Vector3d opening = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    opening[cell_components[i]] += pair.plus_values[q][i] * state(pair.dofs[i]);
+    opening[cell_components[i]] -= pair.minus_values[q][i] * state(pair.dofs[n + i]);
+  }
+  return opening;
+}
+
+template <class VectorType, class MatrixType>
+void FiniteStrainSolver::Impl::assemble_cohesive(const VectorType& state, const LoadState& load, bool with_matrix,
+                                                 const dealii::AffineConstraints<double>* constraints, MatrixType& K,
+                                                 VectorType* rhs, VectorType& f_int) const {
+  // Interface potential Π = ∫ φ(Δ) dA with Δ = Σ N⁺ u⁺ − Σ N⁻ u⁻: f_int,a = ∫ s_a N_a t dA and
+  // K_ab = ∫ s_a N_a (∂t/∂Δ) s_b N_b dA, s = +1 on the + side and −1 on the − side.
+  const std::size_t n = cell_components.size(), nq = face_quadrature->size();
+  const double dt = load.time - committed_time;
+  dealii::FullMatrix<double> local_K(2 * n, 2 * n);
+  dealii::Vector<double> local_rhs(2 * n), local_f(2 * n);
+  std::vector<double> a(2 * n);
+  std::vector<unsigned> comp(2 * n);
+  for (std::size_t i = 0; i < 2 * n; ++i) comp[i] = cell_components[i % n];
+  for (std::size_t p = 0; p < cohesive_pairs.size(); ++p) {
+    const CohesivePair& pair = cohesive_pairs[p];
+    local_K = 0.0;
+    local_rhs = 0.0;
+    local_f = 0.0;
+    for (std::size_t q = 0; q < nq; ++q) {
+      const CohesiveResponse r =
+          cohesive_response(*cohesive_law, cohesive_states[p * nq + q], cohesive_opening(pair, q, state), pair.normal, dt,
+                            cohesive_secant);
+      const double w = pair.weights[q];
+      for (std::size_t i = 0; i < n; ++i) {
+        a[i] = pair.plus_values[q][i];
+        a[n + i] = -pair.minus_values[q][i];
+      }
+      for (std::size_t i = 0; i < 2 * n; ++i) {
+        if (a[i] == 0.0) continue;
+        const double f = a[i] * r.traction[comp[i]] * w;
+        local_f(static_cast<unsigned>(i)) += f;
+        local_rhs(static_cast<unsigned>(i)) -= f;
+        if (with_matrix)
+          for (std::size_t j = 0; j < 2 * n; ++j)
+            local_K(static_cast<unsigned>(i), static_cast<unsigned>(j)) += a[i] * a[j] * r.tangent(comp[i], comp[j]) * w;
+      }
+    }
+    f_int.add(pair.dofs, local_f);
+    if (with_matrix) constraints->distribute_local_to_global(local_K, local_rhs, pair.dofs, K, *rhs);
+  }
+}
+
+CohesiveSummary FiniteStrainSolver::Impl::commit_cohesive(const LoadState& load) {
+  const std::size_t nq = face_quadrature->size();
+  const double dt = load.time - committed_time;
+  const double d0 = cohesive_law->peak_opening();
+  CohesiveSummary summary;
+  for (std::size_t p = 0; p < cohesive_pairs.size(); ++p)
+    for (std::size_t q = 0; q < nq; ++q) {
+      CohesiveState& state = cohesive_states[p * nq + q];
+      const Eigen::Vector3d opening = cohesive_opening(cohesive_pairs[p], q, serial.u);
+      const CohesiveResponse r = cohesive_response(*cohesive_law, state, opening, cohesive_pairs[p].normal, dt);
+      const double w = cohesive_pairs[p].weights[q];
+      if (dt > 0.0) cohesive_viscous_dissipation += r.viscous_power_density * dt * w;
+      state.max_opening = r.damage_opening;
+      state.previous_opening = opening;
+      if (r.failed) summary.failed_area += w;
+      if (r.damage_opening > d0) summary.damaged_area += w;
+      summary.stored_energy += r.stored_energy * w;
+      summary.dissipated_energy += r.dissipated_energy * w;
+      summary.max_damage = std::max(summary.max_damage, r.damage);
+    }
+  committed_time = load.time;
+  summary.viscous_dissipation = cohesive_viscous_dissipation;
+  return summary;
 }
 
 FiniteStrainSolver::FiniteStrainSolver(const FiniteStrainProblem& problem, const SolverSettings& settings)
@@ -666,6 +872,10 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
       }
       constraints.close();
       mismatch = m.max(mismatch);
+      // A cohesive interface whose points switch between loading and unloading can make the
+      // consistent Newton iteration cycle; after a third of the allowed iterations the secant
+      // interface tangent takes over (slower, but it does not cycle).
+      m.cohesive_secant = m.cohesive_law && it >= m.settings.max_newton_iterations / 3;
       auto t0 = Clock::now();
       m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
       report.assembly_seconds += seconds_since(t0);
@@ -718,14 +928,20 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
     }
   } catch (const FiniteStrainError& e) {
     return fail(e.what());
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) { // PETSc/UMFPACK errors (deal.II exceptions are std::exception)
     return fail(std::string("linear solver: ") + e.what());
   }
   // Reactions: the residual on the Dirichlet DOFs is the force the supports put on the body.
   Eigen::Vector3d support_on_body = Eigen::Vector3d::Zero();
+  report.boundary_reactions.assign(m.boundaries.size(), Eigen::Vector3d::Zero());
   for (const auto& d : m.dirichlet)
-    if (la.owns(d.index)) support_on_body[d.component] += assembly.residual[d.index];
+    if (la.owns(d.index)) {
+      support_on_body[d.component] += assembly.residual[d.index];
+      report.boundary_reactions[static_cast<std::size_t>(d.boundary)][d.component] += assembly.residual[d.index];
+    }
   m.sum(std::span<double>(support_on_body.data(), 3));
+  for (Eigen::Vector3d& r : report.boundary_reactions) m.sum(std::span<double>(r.data(), 3));
+  if (m.cohesive_law) report.cohesive = m.commit_cohesive(load);
   report.support_reaction = -support_on_body;
   report.tool_force = -assembly.contact_on_body;
   report.traction_resultant = assembly.traction_on_body;
@@ -739,6 +955,20 @@ std::size_t FiniteStrainSolver::dof_count() const { return m_impl->dof.n_dofs();
 std::size_t FiniteStrainSolver::cell_count() const { return m_impl->tria.n_active_cells(); }
 std::string FiniteStrainSolver::linear_solver_name() const { return m_impl->linear->name(); }
 double FiniteStrainSolver::contact_penalty() const { return m_impl->penalty; }
+std::size_t FiniteStrainSolver::cohesive_point_count() const { return m_impl->cohesive_states.size(); }
+double FiniteStrainSolver::crack_extent(const Eigen::Vector3d& direction) const {
+  const Impl& m = *m_impl;
+  if (!m.cohesive_law) return 0.0;
+  const std::size_t nq = m.face_quadrature->size();
+  const double df = m.cohesive_law->failure_opening();
+  double first = std::numeric_limits<double>::infinity(), reach = -std::numeric_limits<double>::infinity();
+  for (std::size_t p = 0; p < m.cohesive_pairs.size(); ++p) {
+    for (const Eigen::Vector3d& v : m.cohesive_pairs[p].vertices) first = std::min(first, v.dot(direction));
+    for (std::size_t q = 0; q < nq; ++q)
+      if (m.cohesive_states[p * nq + q].max_opening >= df) reach = std::max(reach, m.cohesive_pairs[p].points[q].dot(direction));
+  }
+  return reach > first ? reach - first : 0.0;
+}
 double FiniteStrainSolver::max_displacement() const {
   double best = 0.0;
   const std::vector<double> u = state();
@@ -802,27 +1032,67 @@ std::vector<Eigen::Matrix3d> FiniteStrainSolver::quadrature_cauchy_stresses() co
   return out;
 }
 
+double FiniteStrainSolver::strain_energy() const {
+  const Impl& m = *m_impl;
+  return m.with_algebra([&](const auto& la) {
+    const auto& u = la.ghosted(la.u);
+    dealii::FEValues<3> fv(*m.mapping, *m.fe, *m.cell_quadrature, dealii::update_gradients | dealii::update_JxW_values);
+    std::vector<dealii::Tensor<2, 3>> grads(m.cell_quadrature->size());
+    double energy = 0.0;
+    for (const auto& cell : m.dof.active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      fv.reinit(cell);
+      fv[dealii::FEValuesExtractors::Vector(0)].get_function_gradients(u, grads);
+      for (unsigned q = 0; q < fv.n_quadrature_points; ++q)
+        energy += m.laws[cell->material_id()]->energy(Eigen::Matrix3d::Identity() + to_eigen(grads[q])) * fv.JxW(q);
+    }
+    return m.sum(energy);
+  });
+}
+
 std::vector<double> FiniteStrainSolver::state() const {
   const Impl& m = *m_impl;
-  if (!m.distributed) return std::vector<double>(m.serial.u.begin(), m.serial.u.end());
-  // Every process's locally owned values in place, summed over the processes.
-  const DistributedAlgebra& la = *m.parallel;
-  std::vector<dealii::types::global_dof_index> indices(la.owned.begin(), la.owned.end());
-  std::vector<double> values(indices.size());
-  la.u.extract_subvector_to(indices, values);
-  std::vector<double> all(m.dof.n_dofs(), 0.0);
-  for (std::size_t k = 0; k < indices.size(); ++k) all[indices[k]] = values[k];
-  m.sum(all);
-  return all;
+  std::vector<double> values;
+  if (!m.distributed) {
+    values.assign(m.serial.u.begin(), m.serial.u.end());
+  } else {
+    // Every process's locally owned values in place, summed over the processes.
+    const DistributedAlgebra& la = *m.parallel;
+    std::vector<dealii::types::global_dof_index> indices(la.owned.begin(), la.owned.end());
+    std::vector<double> owned(indices.size());
+    la.u.extract_subvector_to(indices, owned);
+    values.assign(m.dof.n_dofs(), 0.0);
+    for (std::size_t k = 0; k < indices.size(); ++k) values[indices[k]] = owned[k];
+    m.sum(values);
+  }
+  if (m.cohesive_law) { // serial only (build refuses a distributed cohesive interface)
+    for (const CohesiveState& s : m.cohesive_states)
+      values.insert(values.end(), {s.max_opening, s.previous_opening[0], s.previous_opening[1], s.previous_opening[2]});
+    values.push_back(m.committed_time);
+    values.push_back(m.cohesive_viscous_dissipation);
+  }
+  return values;
 }
 
 void FiniteStrainSolver::set_state(const std::vector<double>& values) {
   Impl& m = *m_impl;
-  if (values.size() != m.dof.n_dofs())
-    throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values for " +
-                                std::to_string(m.dof.n_dofs()) + " DOFs");
+  const std::size_t n_dofs = m.dof.n_dofs();
+  const std::size_t expected = n_dofs + (m.cohesive_law ? 4 * m.cohesive_states.size() + 2 : 0);
+  if (values.size() != expected)
+    throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values, expected " + std::to_string(expected) +
+                                " (" + std::to_string(n_dofs) + " DOFs" +
+                                (m.cohesive_law ? " + 4 per cohesive point + 2" : std::string()) + ")");
+  if (m.cohesive_law) {
+    auto it = values.begin() + static_cast<std::ptrdiff_t>(n_dofs);
+    for (CohesiveState& s : m.cohesive_states) {
+      s.max_opening = *it++;
+      for (int c = 0; c < 3; ++c) s.previous_opening[c] = *it++;
+    }
+    m.committed_time = *it++;
+    m.cohesive_viscous_dissipation = *it++;
+  }
   if (!m.distributed) {
-    std::copy(values.begin(), values.end(), m.serial.u.begin());
+    std::copy(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(n_dofs), m.serial.u.begin());
     return;
   }
   DistributedAlgebra& la = *m.parallel;

@@ -16,6 +16,7 @@
 // tangent_solver.cpp in this folder; mpi_processes.cpp includes PETSc).
 
 #include "meshes/tet_mesh.hpp"
+#include "reference/cohesive/cohesive_law.hpp"
 #include "reference/rigid_tool.hpp"
 
 #include <Eigen/Core>
@@ -68,6 +69,20 @@ struct TractionBoundary {
   Eigen::Vector3d total_force = Eigen::Vector3d::Zero(); ///< [N] at load factor 1
 };
 
+/// A cohesive interface along a crack path (Reference II): the mesh has been split along the crack
+/// (meshes/crack_split.hpp) so that its two sides are the surface groups `plus_surface` and
+/// `minus_surface`. The solver pairs their coincident faces by position (also after global
+/// refinement) and joins them with the bilinear law of reference/cohesive/cohesive_law.hpp,
+/// integrated at the face quadrature points of the + side: the interface element of Ortiz &
+/// Pandolfi 1999 (§2), with the opening Δ = x⁺ − x⁻ interpolated by each side's own shape functions.
+/// The normal is the reference one (n from − into +): the interface is geometrically linear, which
+/// holds while the crack faces rotate little (the blade and tearing scenes; say so where it matters).
+struct CohesiveInterfaceSpec {
+  std::string plus_surface;  ///< e.g. "cut_plane+"
+  std::string minus_surface; ///< e.g. "cut_plane-"
+  CohesiveLawParameters law;
+};
+
 /// The boundary-value problem: mesh (metres), materials, supports, loads, tool.
 struct FiniteStrainProblem {
   TetMesh mesh;
@@ -75,6 +90,7 @@ struct FiniteStrainProblem {
   std::vector<DisplacementBoundary> displacement_boundaries;
   std::vector<TractionBoundary> tractions;
   std::optional<RigidToolShape> tool;    ///< rigid tool in frictionless penalty contact
+  std::optional<CohesiveInterfaceSpec> cohesive; ///< crack path held by a cohesive law
 };
 
 /// Linear solver for each Newton step.
@@ -106,6 +122,18 @@ struct SolverSettings {
 struct LoadState {
   double load_factor = 0.0;                               ///< scales tractions and prescribed u
   Eigen::Vector3d tool_position = Eigen::Vector3d::Zero(); ///< tool reference point [m]
+  double time = 0.0; ///< [s] trajectory time; its increment drives the cohesive viscous term
+};
+
+/// The cohesive interface after a converged solve (all zero without one). Energies per the whole
+/// interface; areas in the reference configuration.
+struct CohesiveSummary {
+  double failed_area = 0.0;        ///< area whose points have failed (κ >= δ_f) [m^2]
+  double damaged_area = 0.0;       ///< area whose points are past the peak (κ > δ_0) [m^2]
+  double stored_energy = 0.0;      ///< recoverable interface energy ∫ φ_e dA [J]
+  double dissipated_energy = 0.0;  ///< cohesive dissipation ∫ φ_d(κ) dA, total so far [J]
+  double viscous_dissipation = 0.0; ///< ∫∫ η |Δ̇|² dA dt, total so far [J]
+  double max_damage = 0.0;         ///< largest 1 − K(κ)/K_0 over the points
 };
 
 /// What one equilibrium solve did and found.
@@ -116,6 +144,10 @@ struct EquilibriumReport {
   Eigen::Vector3d tool_force = Eigen::Vector3d::Zero();       ///< contact resultant: body on tool [N]
   Eigen::Vector3d support_reaction = Eigen::Vector3d::Zero(); ///< body on its supports [N]
   Eigen::Vector3d traction_resultant = Eigen::Vector3d::Zero(); ///< applied tractions on the body [N]
+  /// Force each displacement boundary puts on the body [N], in the order of
+  /// FiniteStrainProblem::displacement_boundaries (a DOF shared by two goes to the first that fixes it).
+  std::vector<Eigen::Vector3d> boundary_reactions;
+  CohesiveSummary cohesive; ///< the interface after this solve (converged solves only)
   int contact_points = 0;    ///< boundary quadrature points inside the tool
   double contact_area = 0.0; ///< reference area of those points' weights [m^2]
   double max_contact_pressure = 0.0; ///< [Pa]
@@ -151,6 +183,11 @@ public:
   [[nodiscard]] double contact_penalty() const;
   /// The number of MPI processes the mesh is distributed over (1: serial).
   [[nodiscard]] int process_count() const;
+  /// Cohesive interface: its quadrature points (0 without one) and how far the failed part
+  /// reaches along `direction` (unit) beyond the interface's first point along it [m] — the crack
+  /// depth c of paper 001 Fig. 3 when `direction` is the cutting direction; 0 if nothing failed.
+  [[nodiscard]] std::size_t cohesive_point_count() const;
+  [[nodiscard]] double crack_extent(const Eigen::Vector3d& direction) const;
 
   /// Displacement [m] at reference point X (evaluated in the tetrahedron containing X). Throws
   /// std::out_of_range if X lies outside the mesh.
@@ -158,12 +195,16 @@ public:
   /// Cauchy stress [Pa] at every cell quadrature point of the current state (distributed: of this
   /// process's locally owned cells only).
   [[nodiscard]] std::vector<Eigen::Matrix3d> quadrature_cauchy_stresses() const;
+  /// Stored elastic energy of the body ∫ ψ(F) dV over the reference volume [J] (for energy
+  /// balances: external work = strain energy + interface energy + dissipation).
+  [[nodiscard]] double strain_energy() const;
   /// Largest displacement magnitude over the DOFs [m].
   [[nodiscard]] double max_displacement() const;
 
   /// The state for a checkpoint: the DOF values of the displacement, all of them in global DOF
   /// order on every process (distributed: gathered; the numbering depends on the process count,
-  /// so a state is restored with the same number of processes).
+  /// so a state is restored with the same number of processes), followed (with a cohesive
+  /// interface) by each interface point's history (κ, previous opening) and the last time.
   [[nodiscard]] std::vector<double> state() const;
   /// Restores a checkpointed state. Throws std::invalid_argument on a size mismatch.
   void set_state(const std::vector<double>& values);

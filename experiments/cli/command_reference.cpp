@@ -1,5 +1,5 @@
 // kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [-o DIR] [--resume] [--no-fields]
-// [--solver auto|direct|iterative] [--np N]: the finite-strain reference along the scene's
+// [--solver auto|direct|iterative] [--np N] [--fracture auto|on|off]: the finite-strain reference along the scene's
 // trajectory (issue 3), written as profile.csv + manifest.json (+ fields.pvd), with a progress
 // line per sample and checkpoints to resume from. `--np N` re-launches the same command under
 // `mpirun -np N` (as `mpirun -np N kerf reference …` does directly): the solver runs distributed.
@@ -37,6 +37,7 @@ struct ReferenceOptions {
   int refine = 0;
   int samples = 0; ///< 0 = every trajectory sample
   bool resume = false;
+  std::string fracture = "auto";
   bool no_fields = false;
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
   reference::LinearSolverChoice solver = reference::LinearSolverChoice::automatic;
@@ -91,6 +92,7 @@ void run_reference_command(const ReferenceOptions& o) {
   settings.write_fields = !o.no_fields;
   settings.resume = o.resume;
   settings.linear_solver = o.solver;
+  settings.fracture = o.fracture == "on" ? ReferenceFracture::on : o.fracture == "off" ? ReferenceFracture::off : ReferenceFracture::automatic;
   if (o.samples < 0) throw std::invalid_argument("--samples must be >= 1, got " + std::to_string(o.samples));
   if (o.samples > 0) {
     if (scene.tools.empty()) throw std::invalid_argument("scene '" + scene.name + "' has no tool");
@@ -134,6 +136,9 @@ void add_reference_command(CLI::App& app) {
   cmd->add_option("--np", options->np,
                   "run distributed on N MPI processes: re-launches this command under mpirun -np N")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--fracture", options->fracture,
+                  "cohesive fracture along the scene's cut_plane: auto (cutting/tearing scenes with σ_c and J_c), on, off")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_option("--trajectory", options->trajectory,
                   "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   cmd->callback([options] { run_reference_command(*options); });

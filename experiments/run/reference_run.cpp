@@ -332,7 +332,13 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   if (settings.checkpoint_every < 1)
     throw std::invalid_argument("reference: checkpoint_every must be >= 1, got " + std::to_string(settings.checkpoint_every));
 
-  const ReferenceProblem rp = reference_problem(scene, mesh);
+  ReferenceProblem rp = reference_problem(scene, mesh);
+  const CrackPathInfo crack = add_crack_path(scene, rp.problem, settings.fracture, settings.refinements);
+  if (!crack.warning.empty()) std::fprintf(stderr, "reference %s: warning: %s\n", scene.name.c_str(), crack.warning.c_str());
+  // The crack extent is measured along the blade's cutting direction (c of paper 001 Fig. 3), or
+  // downwards from the grasped top for a tear.
+  const Eigen::Vector3d crack_direction =
+      scene.tools.front().kind == Tool::Kind::blade ? scene.tools.front().blade.cutting_direction : Eigen::Vector3d(0, 0, -1);
   const std::size_t n = rp.positions.size();
   std::vector<std::size_t> indices = settings.sample_indices;
   if (indices.empty())
@@ -343,7 +349,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                   " (the trajectory's sample count); entry " + std::to_string(i) + " is " +
                                   std::to_string(indices[i]));
   const double T = rp.times.back();
-  auto load_of = [&](std::size_t k) { return LoadState{T > 0.0 ? rp.times[k] / T : 0.0, rp.positions[k]}; };
+  auto load_of = [&](std::size_t k) { return LoadState{T > 0.0 ? rp.times[k] / T : 0.0, rp.positions[k], rp.times[k]}; };
   const bool tied = rp.coupling.kind == ReferenceToolCoupling::Kind::tied;
   const std::string tool_name = scene.tools.front().name;
 
@@ -392,6 +398,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                std::to_string(cp.processes) + ")");
     solver.set_state(saved.state);
     cp = std::move(saved);
+    cp.last.time = cp.last.load_factor * T; // the load factor is t/T (load_of), also between samples
     resumed_from = cp.solved;
     if (writer)
       std::fprintf(stderr, "reference %s: resuming after sample %zu/%zu from %s\n", scene.name.c_str(), cp.solved,
@@ -410,6 +417,14 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   const std::size_t first = cp.solved;
   int newton_total = 0;
   for (const auto& s : cp.samples) newton_total += s.at("newton_iterations").get<int>();
+  // Energy bookkeeping and the interface state of the previous sample (for the modes), restored
+  // from the last sample record on resume.
+  EnergyBookkeeping energy;
+  reference::CohesiveSampleState previous_interface;
+  if (!cp.samples.empty() && cp.samples.back().contains("energy")) {
+    energy = EnergyBookkeeping::from_json(cp.samples.back().at("energy"));
+    previous_interface = {cp.samples.back().at("contact_points").get<int>() > 0, cp.samples.back().at("energy").at("failed_area_m2").get<double>()};
+  }
   for (std::size_t i = cp.solved; i < indices.size(); ++i) {
     const std::size_t k = indices[i];
     reference::LoadStepReport step;
@@ -440,6 +455,13 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     row.force = tool_force;
     const bool touching = tied ? tool_force.norm() > 0.0 : step.equilibrium.contact_points > 0;
     row.mode = touching ? InteractionMode::deformation_1 : InteractionMode::no_contact;
+    const reference::CohesiveSampleState interface{touching, step.equilibrium.cohesive.failed_area};
+    if (crack.active) {
+      row.mode = reference::reference_mode(previous_interface, interface);
+      row.crack_extent = solver.crack_extent(crack_direction);
+    }
+    previous_interface = interface;
+    energy.add_sample({rp.positions[k]}, {-tool_force}, solver.strain_energy(), step.equilibrium.cohesive);
     row.cost_s = cost;
     cp.profile.rows.push_back(row);
     cp.samples.push_back({{"index", k},
@@ -451,7 +473,8 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                           {"seconds", cost},
                           {"tool_force_N", vec_json(tool_force)},
                           {"support_reaction_N", vec_json(support)},
-                          {"contact_points", step.equilibrium.contact_points}});
+                          {"contact_points", step.equilibrium.contact_points},
+                          {"energy", energy.to_json()}});
     cp.solve_seconds += cost;
     newton_total += step.newton_iterations;
     cp.solved = i + 1;
@@ -520,6 +543,15 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                   {"solve_total_s", cp.solve_seconds},
                   {"samples_solved", cp.solved}};
   m["newton_iterations_total"] = newton_total;
+  m["energy"] = energy.to_json();
+  m["fracture"] = crack.active ? nlohmann::json{{"cohesive_law", "bilinear (Camacho-Ortiz effective opening), reference/cohesive/cohesive_law.hpp"},
+                                                {"cohesive_strength_Pa", scene.material.cohesive_strength},
+                                                {"fracture_toughness_J_per_m2", scene.material.fracture_toughness},
+                                                {"interface_triangles", crack.interface_triangles},
+                                                {"cohesive_zone_length_m", crack.zone_length},
+                                                {"elements_in_zone", crack.elements_in_zone},
+                                                {"warning", crack.warning}}
+                               : nlohmann::json(nullptr);
   m["samples"] = cp.samples;
   m["stopped"] = stop.empty() ? nlohmann::json(nullptr) : nlohmann::json(stop);
   m["resumed_after_sample"] = resumed_from ? nlohmann::json(*resumed_from) : nlohmann::json(nullptr);

@@ -7,6 +7,7 @@
 // Includes reference/*.hpp only, which include no deal.II.
 
 #include "experiments/profile/force_profile.hpp"
+#include "experiments/run/reference_fracture.hpp"
 #include "experiments/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "reference/finite_strain_solver.hpp"
@@ -33,6 +34,8 @@ struct ReferenceRunSettings {
   /// Under `mpirun -np N` (N > 1): distribute the mesh over the N processes (true) or solve the
   /// whole problem on every process (false). See reference::SolverSettings::distribute.
   bool distribute = true;
+  /// Cohesive fracture along the scene's cut_plane (Reference II; reference_fracture.hpp).
+  ReferenceFracture fracture = ReferenceFracture::automatic;
 };
 
 /// How the scene's tool is coupled to the body in the reference.
