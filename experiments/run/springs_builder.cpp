@@ -31,7 +31,8 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
     setup.integrator = *integrator;
   }
   const Material& m = scene.material;
-  setup.youngs_modulus = m.youngs_modulus;
+  // A calibrated scene scales the modulus the spring constants are identified from ([models.springs]).
+  setup.youngs_modulus = m.youngs_modulus * (scene.springs ? scene.springs->stiffness_scale : 1.0);
   setup.poisson_ratio = m.poisson_ratio;
   setup.density = m.density;
   setup.damping = m.damping;
@@ -52,6 +53,7 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
   p["nodes"] = net.node_count;
   p["spring_constants_N_per_m"] = {{"edge", id.stiffness.edge}, {"face_diagonal", id.stiffness.face_diagonal},
                                    {"body_diagonal", id.stiffness.body_diagonal}};
+  p["stiffness_scale"] = scene.springs ? scene.springs->stiffness_scale : 1.0;
   p["volume_modulus_Pa"] = id.stiffness.volume_modulus;
   p["network_poisson_ratio"] = id.poisson_ratio;
   p["bulk_modulus_error"] = id.bulk_modulus_error;

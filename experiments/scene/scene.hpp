@@ -86,6 +86,15 @@ struct VoxelModelSettings {
   bool clip_friction = true;            ///< CFF of paper 002 Eq. (1) on (case d) or off (a, c)
 };
 
+/// Calibrated setting of the spring-network model (paper 000 §2), [models.springs]; written by
+/// `kerf calibrate` (docs/studies.md).
+struct SpringsModelSettings {
+  /// Factor on the Young's modulus the network's spring constants are identified from (paper 000
+  /// §2.1 identifies them from E and ν of the continuum; a coarse network around the stylus is
+  /// stiffer or softer than the body it stands for, and calibration fits this factor) [–] > 0.
+  double stiffness_scale = 1.0;
+};
+
 struct Scene {
   std::filesystem::path file;        ///< the scene file as given
   std::string name;
@@ -98,6 +107,7 @@ struct Scene {
   std::vector<Tool> tools;           ///< one or two
   std::optional<FractureResponseParameters> fracture;  ///< [models.fracture]
   std::optional<VoxelModelSettings> voxel;             ///< [models.voxel]
+  std::optional<SpringsModelSettings> springs;         ///< [models.springs]
 };
 
 } // namespace kerf
