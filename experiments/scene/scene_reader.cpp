@@ -739,12 +739,40 @@ private:
   }
 
   SpringsModelSettings read_springs(const TableRef& t) const {
-    allow_only(t, {"stiffness_scale"});
+    allow_only(t, {"stiffness_scale", "cells", "cell_size", "integrator", "volume_term", "tensile_limit", "damping",
+                   "grasp_radius"});
     SpringsModelSettings s;
     if (const auto v = optional_quantity(t, "stiffness_scale", Dimension::dimensionless)) {
       s.stiffness_scale = *v;
       check(*v > 0.0, t, "stiffness_scale", "a factor > 0");
     }
+    if (t.find("cells") != nullptr) {
+      s.cells = required_integer(t, "cells");
+      check(*s.cells >= 1 && *s.cells <= 64, t, "cells", "a cell count per side in 1 .. 64");
+    }
+    if (const toml::node* n = t.find("cell_size")) {
+      const auto* text = n->as_string();
+      if (text == nullptr || text->get() != "auto") {
+        s.cell_size = required_quantity(t, "cell_size", Dimension::length);
+        check(*s.cell_size > 0.0, t, "cell_size", "a length > 0 or \"auto\"");
+      }
+    }
+    if (const auto integrator = optional_string(t, "integrator")) {
+      if (*integrator != "explicit" && *integrator != "implicit" && *integrator != "static")
+        wrong(*t.find("integrator"), t, t.key("integrator"), "\"explicit\", \"implicit\" or \"static\"");
+      s.integrator = *integrator;
+    }
+    if (const toml::node* n = t.find("volume_term")) {
+      const auto* b = n->as_boolean();
+      if (b == nullptr) wrong(*n, t, t.key("volume_term"), "true or false");
+      s.volume_term = b->get();
+    }
+    if ((s.tensile_limit = optional_quantity(t, "tensile_limit", Dimension::pressure)))
+      check(*s.tensile_limit > 0.0, t, "tensile_limit", "a stress > 0");
+    if ((s.damping = optional_quantity(t, "damping", Dimension::viscosity)))
+      check(*s.damping >= 0.0, t, "damping", "a viscosity >= 0");
+    if ((s.grasp_radius = optional_quantity(t, "grasp_radius", Dimension::length)))
+      check(*s.grasp_radius > 0.0, t, "grasp_radius", "a length > 0");
     return s;
   }
 
