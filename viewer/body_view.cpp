@@ -23,6 +23,7 @@
 #include <vtkTextProperty.h>
 #include <vtkUnstructuredGrid.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -230,7 +231,24 @@ void BodyView::set_body(vtkDataSet* body) {
   }
   if (!array)
     throw std::invalid_argument(std::string("viewer: the body carries no \"") + name + "\" data to colour by");
-  m_data_max = array->GetNumberOfComponents() == 3 ? array->GetMaxNorm() : array->GetRange(0)[1];
+  // The top of the automatic colour range: the 99th percentile of the values, so that a few
+  // extreme elements (a sliver, a contact spike) do not wash the rest of the body into one colour.
+  std::vector<double> values(static_cast<std::size_t>(array->GetNumberOfTuples()));
+  for (vtkIdType i = 0; i < array->GetNumberOfTuples(); ++i) {
+    if (array->GetNumberOfComponents() == 3) {
+      double v[3];
+      array->GetTuple(i, v);
+      values[static_cast<std::size_t>(i)] = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    } else {
+      values[static_cast<std::size_t>(i)] = array->GetComponent(i, 0);
+    }
+  }
+  m_data_max = 0.0;
+  if (!values.empty()) {
+    const auto k = static_cast<std::ptrdiff_t>(0.99 * static_cast<double>(values.size() - 1));
+    std::nth_element(values.begin(), values.begin() + k, values.end());
+    m_data_max = values[static_cast<std::size_t>(k)];
+  }
   m_body->VisibilityOn();
 }
 

@@ -80,7 +80,7 @@ public:
   void set_legend_visible(bool visible);
   /// Colour range [0, max] of the colouring quantity (m or Pa).
   void set_colour_range(double max);
-  /// Largest value of the colouring quantity in the last body set (m or Pa).
+  /// 99th percentile of the colouring quantity over the last body set's points or cells (m or Pa).
   [[nodiscard]] double data_maximum() const { return m_data_max; }
   [[nodiscard]] vtkRenderer* renderer() const { return m_renderer; }
 

@@ -25,7 +25,7 @@ size=(--width 960 --height 640)
 view "$runs/clay_pull/springs" --at 1.6 --no-chart "${size[@]}" --screenshot "$out/clay_pull_springs.png"
 view "$runs/clay_tear/springs" --at 3 --no-chart "${size[@]}" --screenshot "$out/clay_tear_springs.png"
 view sponge_cut_constant --model voxel --at 1.2 "${size[@]}" --screenshot "$out/sponge_cut_voxel.png"
-view potato_rect_cut --model fracture --at 2 "${size[@]}" --screenshot "$out/potato_rect_cut_fracture.png"
+view potato_rect_cut --model fracture --at 8 "${size[@]}" --screenshot "$out/potato_rect_cut_fracture.png"
 
 # Replay side by side: the reference's fields beside the spring network's embedded mesh, both
 # coloured by von Mises stress on one scale, with the force-displacement chart below.
