@@ -37,7 +37,7 @@ struct ReferenceOptions {
   int refine = 0;
   int samples = 0; ///< 0 = every trajectory sample
   bool resume = false;
-  std::string fracture = "auto";
+  std::string fracture = "off";
   bool no_fields = false;
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
   reference::LinearSolverChoice solver = reference::LinearSolverChoice::automatic;
@@ -137,7 +137,7 @@ void add_reference_command(CLI::App& app) {
                   "run distributed on N MPI processes: re-launches this command under mpirun -np N")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--fracture", options->fracture,
-                  "cohesive fracture along the scene's cut_plane: auto (cutting/tearing scenes with σ_c and J_c), on, off")
+                  "cohesive fracture along the scene's cut_plane: off (default until Reference II is complete), auto (cutting/tearing scenes with σ_c and J_c), on")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_option("--trajectory", options->trajectory,
                   "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
