@@ -4,6 +4,7 @@
 #
 #   bash experiments/setup_and_run.sh default   # build, then the default job
 #   bash experiments/setup_and_run.sh test      # build, then every test through ctest
+#   bash experiments/setup_and_run.sh asan      # AddressSanitizer + UBSan build (build-asan), every test
 set -euo pipefail
 job="${1:-default}"
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -13,7 +14,7 @@ build="${KERF_BUILD_DIR:-$here/build}"
 packages=(cmake g++ make pkg-config git
           libeigen3-dev libgmsh-dev libvtk9-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
           libssl-dev libgtest-dev libbenchmark-dev python3-matplotlib
-          libdeal.ii-dev libopenblas0-pthread openmpi-bin)
+          libdeal.ii-dev libopenblas0-pthread openmpi-bin clang-14 libclang-rt-14-dev libsuitesparse-dev)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -26,7 +27,14 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=Release
+build_type=Release
+options=()
+if [ "$job" = asan ]; then # docs/reliability.md: flags, run-time options, the leak suppressions
+  build="${KERF_BUILD_DIR:-$here/build-asan}"
+  build_type=Asan
+  options=(-DKERF_BENCHMARKS=OFF)
+fi
+cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=$build_type "${options[@]}"
 cmake --build "$build" -j2
 
 case "$job" in
@@ -40,8 +48,15 @@ case "$job" in
     cd "$build"
     ctest -j2 --output-on-failure --timeout 900
     ;;
+  asan)
+    cd "$build"
+    export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:check_initialization_order=1"
+    export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+    export LSAN_OPTIONS="suppressions=$here/cmake/lsan_suppressions.txt:print_suppressions=0"
+    ctest -j2 --output-on-failure --timeout 2700
+    ;;
   *)
-    echo "usage: $0 default|test" >&2
+    echo "usage: $0 default|test|asan" >&2
     exit 64
     ;;
 esac

@@ -1,5 +1,11 @@
 // The deal.II side of the finite-strain reference (finite_strain_solver.hpp): triangulation from
 // TetMesh, FE space, total-Lagrangian assembly, penalty contact, Newton with line search, output.
+//
+// One Newton, line search and assembly for two linear algebras: SerialAlgebra (deal.II Vector and
+// SparseMatrix, UMFPACK or PETSc CG on this process alone) and DistributedAlgebra (the mesh
+// distributed over the MPI processes as a parallel::fullydistributed::Triangulation, PETSc MPI
+// vectors and matrix, MUMPS or CG + GAMG on MPI_COMM_WORLD). Each process assembles its locally
+// owned cells; norms, contact resultants and reactions are summed over the processes.
 
 #include "reference/finite_strain_solver.hpp"
 
@@ -8,20 +14,29 @@
 #include "reference/material/finite_strain_error.hpp"
 #include "reference/material/neo_hookean.hpp"
 #include "reference/material/st_venant_kirchhoff.hpp"
+#include "reference/mpi_processes.hpp"
 #include "reference/tangent_solver.hpp"
+#include "meshes/atomic_file.hpp"
 
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/distributed/fully_distributed_tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_simplex_p.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_fe.h>
+#include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria.h>
+#include <deal.II/grid/tria_description.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/petsc_sparse_matrix.h>
+#include <deal.II/lac/petsc_vector.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/sparsity_pattern.h>
+#include <deal.II/lac/sparsity_tools.h>
 #include <deal.II/lac/vector.h>
 #include <deal.II/numerics/data_out.h>
 #include <deal.II/numerics/data_postprocessor.h>
@@ -34,6 +49,7 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <climits>
 #include <map>
 #include <span>
 #include <stdexcept>
@@ -53,6 +69,22 @@ Eigen::Matrix3d to_eigen(const dealii::Tensor<2, 3>& t) {
 }
 Eigen::Vector3d to_eigen(const dealii::Point<3>& p) { return {p[0], p[1], p[2]}; }
 
+/// Every process's `values`, in rank order (MPI_Allgatherv; collective on `comm`).
+std::vector<std::vector<double>> all_gather(MPI_Comm comm, const std::vector<double>& values) {
+  int size = 0;
+  MPI_Comm_size(comm, &size);
+  int count = static_cast<int>(values.size());
+  std::vector<int> counts(static_cast<std::size_t>(size)), offsets(static_cast<std::size_t>(size) + 1, 0);
+  MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  for (std::size_t r = 0; r < counts.size(); ++r) offsets[r + 1] = offsets[r] + counts[r];
+  std::vector<double> all(static_cast<std::size_t>(offsets.back()));
+  MPI_Allgatherv(values.data(), count, MPI_DOUBLE, all.data(), counts.data(), offsets.data(), MPI_DOUBLE, comm);
+  std::vector<std::vector<double>> out;
+  for (std::size_t r = 0; r < counts.size(); ++r)
+    out.emplace_back(all.begin() + offsets[r], all.begin() + offsets[r + 1]);
+  return out;
+}
+
 std::unique_ptr<HyperelasticLaw> make_law(const MaterialRegion& region) {
   const LameParameters lame = lame_parameters(region.youngs_modulus, region.poisson_ratio);
   switch (region.law) {
@@ -65,12 +97,53 @@ std::unique_ptr<HyperelasticLaw> make_law(const MaterialRegion& region) {
   throw std::invalid_argument("finite strain solver: unknown material law");
 }
 
+/// The linear algebra of one process alone: deal.II's serial vector and sparse matrix.
+struct SerialAlgebra {
+  using VectorType = dealii::Vector<double>;
+  using MatrixType = dealii::SparseMatrix<double>;
+  std::size_t n = 0;
+  dealii::SparsityPattern pattern;
+  MatrixType K;
+  VectorType u;         ///< the displacement DOFs
+  VectorType free_mask; ///< 1 on free DOFs, 0 on Dirichlet DOFs
+  void reinit(VectorType& v) const { v.reinit(n); }
+  /// The vector with the values every cell of this process reads: itself.
+  const VectorType& ghosted(const VectorType& v) const { return v; }
+  [[nodiscard]] bool owns(dealii::types::global_dof_index) const { return true; }
+  void prepare(dealii::AffineConstraints<double>&) const {}
+};
+
+/// The linear algebra of the distributed mesh: PETSc MPI vectors and matrix over the locally
+/// owned DOFs of this process, ghosted copies for the locally relevant ones.
+struct DistributedAlgebra {
+  using VectorType = dealii::PETScWrappers::MPI::Vector;
+  using MatrixType = dealii::PETScWrappers::MPI::SparseMatrix;
+  MPI_Comm comm = MPI_COMM_WORLD;
+  dealii::IndexSet owned, relevant;
+  MatrixType K;
+  VectorType u;
+  VectorType free_mask;
+  mutable VectorType ghost; ///< locally relevant values of the last vector passed to ghosted()
+  void reinit(VectorType& v) const { v.reinit(owned, comm); }
+  /// `v` (locally owned values) with the ghost values of the locally relevant DOFs (collective).
+  const VectorType& ghosted(const VectorType& v) const {
+    ghost = v;
+    return ghost;
+  }
+  [[nodiscard]] bool owns(dealii::types::global_dof_index i) const { return owned.is_element(i); }
+  void prepare(dealii::AffineConstraints<double>& c) const { c.reinit(relevant); }
+};
+
 } // namespace
 
 struct FiniteStrainSolver::Impl {
   SolverSettings settings;
   std::vector<std::string> surface_names;
-  dealii::Triangulation<3> tria;
+  dealii::Triangulation<3> tria; // the whole mesh, on every process (refined before distribution)
+  bool distributed = false;      // the mesh is distributed over MPI_COMM_WORLD's processes
+  int process_count = 1;
+  int rank = 0;
+  std::unique_ptr<dealii::parallel::fullydistributed::Triangulation<3>> distributed_tria;
   std::unique_ptr<dealii::FESystem<3>> fe;
   std::unique_ptr<dealii::MappingFE<3>> mapping;
   dealii::DoFHandler<3> dof;
@@ -96,20 +169,89 @@ struct FiniteStrainSolver::Impl {
   }
   std::optional<RigidToolShape> tool;
   double penalty = 0.0;
-  // Blade edge pass (blade_edge_contact.hpp): the boundary as flat facets on the nodes (P2 faces
-  // split into four at their edge midpoints), the nodes' reference positions, its settings.
-  std::vector<BoundaryFacet> facets;
-  std::vector<Eigen::Vector3d> node_positions;
-  BladeEdgeContactSettings edge_settings;
+  double h_min = 0.0; // the shortest edge of the (refined) mesh [m]
 
-  dealii::SparsityPattern pattern;
-  dealii::SparseMatrix<double> K;
-  dealii::Vector<double> u;
+  // Blade edge pass (contact/blade_edge_contact.hpp), the second contact pass of a wedge tool: the
+  // boundary facets of the whole body as flat triangles on compact node numbers (a P2 face split
+  // into four at its edge midpoints). Every process holds all of them and evaluates the same
+  // contact; each assembles only the terms on the facets of its own cells, and supplies the
+  // displacements of the nodes it is the first process to hold.
+  struct BladeEdgeBoundary {
+    std::vector<BoundaryFacet> facets;                     // compact node numbers, outward
+    std::vector<char> facet_here;                          // this process assembles its terms
+    std::vector<dealii::types::global_dof_index> node_of;  // compact -> global node k (DOFs 3k + c)
+    std::vector<Eigen::Vector3d> positions;                // compact -> reference position [m]
+    std::vector<char> node_here;                           // this process supplies its displacement
+    BladeEdgeContactSettings settings;
+    mutable std::vector<double> displacement;              // 3 per compact node, per assembly
+  };
+  std::optional<BladeEdgeBoundary> blade_edge;
+  void build_blade_edge();
+  template <class VectorType, class MatrixType, class Tally>
+  void assemble_blade_edge(const VectorType& state, const LoadState& load, bool with_matrix, Tally& out,
+                           const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
+                           VectorType& f_ext) const;
+
+  SerialAlgebra serial;
+  // Only when distributed: PETSc objects need PETSc (and MPI) initialised, which a serial run never does.
+  std::unique_ptr<DistributedAlgebra> parallel;
+
+  // Cohesive interface (Reference II): coincident face pairs of the split crack path, with each
+  // side's shape values cached at the + face's quadrature points (the reference configuration
+  // does not change), and one history per quadrature point.
+  struct CohesivePair {
+    std::vector<dealii::types::global_dof_index> dofs; // the + cell's n DOFs, then the − cell's n
+    std::vector<std::vector<double>> plus_values;      // [q][i]: N_i of the + cell (component comp[i])
+    std::vector<std::vector<double>> minus_values;     // [q][j]: N_j of the − cell
+    std::vector<double> weights;                       // reference area weights JxW
+    std::vector<Eigen::Vector3d> points;               // reference positions
+    std::array<Eigen::Vector3d, 3> vertices;           // the face's reference vertices
+    Eigen::Vector3d normal;                            // n, from − into + (reference)
+  };
+  std::optional<CohesiveLawParameters> cohesive_law;
+  std::vector<CohesivePair> cohesive_pairs;
+  // The faces of the crack path, by active cell index × 4 + face: the unit direction into each
+  // face's own material (+n on the + side, −n on the − side), which the wedge contact needs
+  // (rigid_tool.hpp, tool_contact's `side`).
+  std::map<std::size_t, Eigen::Vector3d> crack_face_sides;
+  Eigen::Vector3d crack_side(const dealii::DoFHandler<3>::active_cell_iterator& cell, unsigned f) const {
+    if (crack_face_sides.empty()) return Eigen::Vector3d::Zero();
+    const auto it = crack_face_sides.find(4 * cell->active_cell_index() + f);
+    return it == crack_face_sides.end() ? Eigen::Vector3d::Zero() : it->second;
+  }
+  std::vector<CohesiveState> cohesive_states; // pair-major, then quadrature point
+  std::vector<unsigned> cell_components;      // component of each local DOF of a cell
+  double cohesive_viscous_dissipation = 0.0;
+  double committed_time = 0.0;
+  bool cohesive_secant = false; // Newton fallback: the secant interface tangent (cohesive_law.hpp)
+  void build_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group);
+  template <class VectorType>
+  Eigen::Vector3d cohesive_opening(const CohesivePair& pair, std::size_t q, const VectorType& state) const;
+  template <class VectorType, class MatrixType>
+  void assemble_cohesive(const VectorType& state, const LoadState& load, bool with_matrix,
+                         const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
+                         VectorType& f_int) const;
+  CohesiveSummary commit_cohesive(const LoadState& load);
   std::unique_ptr<TangentSolver> linear;
 
+  /// Calls f with the algebra in use (the distributed one when the mesh is distributed).
+  template <class F> decltype(auto) with_algebra(F&& f) { return distributed ? f(*parallel) : f(serial); }
+  template <class F> decltype(auto) with_algebra(F&& f) const {
+    return distributed ? f(static_cast<const DistributedAlgebra&>(*parallel)) : f(serial);
+  }
+
+  /// Sums over the processes (in place) when distributed.
+  void sum(std::span<double> values) const {
+    if (distributed && !values.empty())
+      dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(values.data(), values.size()), parallel->comm,
+                                  dealii::ArrayView<double>(values.data(), values.size()));
+  }
+  double sum(double value) const { return distributed ? dealii::Utilities::MPI::sum(value, parallel->comm) : value; }
+  double max(double value) const { return distributed ? dealii::Utilities::MPI::max(value, parallel->comm) : value; }
+
   // Result of one assembly.
-  struct Assembly {
-    dealii::Vector<double> residual; // f_int − f_ext − f_contact, all DOFs
+  template <class VectorType> struct Assembly {
+    VectorType residual; // f_int − f_ext − f_contact, all DOFs
     double internal_norm = 0.0;      // |f_int|
     double external_norm = 0.0;      // |f_ext + f_contact|
     Eigen::Vector3d contact_on_body = Eigen::Vector3d::Zero();
@@ -117,9 +259,9 @@ struct FiniteStrainSolver::Impl {
     int contact_points = 0;
     double contact_area = 0.0;
     double max_pressure = 0.0;
-    int edge_points = 0;
-    double edge_length = 0.0;
-    double max_line_load = 0.0;
+    int edge_points = 0;        // blade edge points inside the body
+    double edge_length = 0.0;   // their share of the edge [m]
+    double max_line_load = 0.0; // [N/m]
   };
 
   double dirichlet_target(const DirichletDof& d, double load) const {
@@ -129,15 +271,23 @@ struct FiniteStrainSolver::Impl {
   }
 
   void build(const FiniteStrainProblem& problem);
-  void assemble(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix, Assembly& out,
-                const dealii::AffineConstraints<double>* constraints, dealii::Vector<double>* rhs);
-  void build_blade_edge(const std::vector<dealii::Point<3>>& support, double h_min);
-  void add_blade_edge_contact(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
-                              Assembly& out, const dealii::AffineConstraints<double>* constraints,
-                              dealii::Vector<double>* rhs, dealii::Vector<double>& f_ext);
-  double free_norm(const dealii::Vector<double>& r) const {
-    dealii::Vector<double> copy = r;
-    for (const auto& d : dirichlet) copy[d.index] = 0.0;
+  template <class Algebra>
+  void assemble(Algebra& la, const typename Algebra::VectorType& owned_state, const LoadState& load, bool with_matrix,
+                Assembly<typename Algebra::VectorType>& out, const dealii::AffineConstraints<double>* constraints,
+                typename Algebra::VectorType* rhs);
+  /// The cell loop of `assemble`: this process's cells into K, rhs, f_int, f_ext and the tallies.
+  template <class VectorType, class MatrixType, class Tally>
+  void assemble_cells(const VectorType& state, const LoadState& load, bool with_matrix, Tally& out,
+                      const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
+                      VectorType& f_int, VectorType& f_ext) const;
+  template <class Algebra> EquilibriumReport solve(Algebra& la, const LoadState& load);
+  /// The fields of the displacement `u` (locally relevant values) to `file` (see write_fields).
+  template <class VectorType>
+  void write_fields(const VectorType& u, const std::filesystem::path& file, const LoadState& load) const;
+  /// |r| over the free DOFs (the Dirichlet entries masked out).
+  template <class VectorType> double free_norm(const VectorType& r, const VectorType& mask) const {
+    VectorType copy = r;
+    copy.scale(mask);
     return copy.l2_norm();
   }
 };
@@ -218,6 +368,24 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     }
   if (settings.refinements > 0) tria.refine_global(static_cast<unsigned>(settings.refinements));
 
+  // Under mpirun with N > 1 processes: METIS splits the (refined) mesh into N parts and each
+  // process keeps its part plus a layer of ghost cells (deal.II's tests/simplex/step-40 way;
+  // a fully distributed triangulation cannot be refined afterwards).
+  if (settings.distribute) {
+    const MpiProcesses processes = mpi_processes();
+    distributed = processes.count > 1;
+    process_count = processes.count;
+    rank = processes.rank;
+  }
+  if (distributed) {
+    parallel = std::make_unique<DistributedAlgebra>();
+    dealii::GridTools::partition_triangulation(static_cast<unsigned>(process_count), tria);
+    const auto description =
+        dealii::TriangulationDescription::Utilities::create_description_from_triangulation(tria, parallel->comm);
+    distributed_tria = std::make_unique<dealii::parallel::fullydistributed::Triangulation<3>>(parallel->comm);
+    distributed_tria->create_triangulation(description);
+  }
+
   auto group_of = [&](const std::string& name, const char* what) {
     for (std::size_t g = 0; g < surface_names.size(); ++g)
       if (surface_names[g] == name) return static_cast<int>(g);
@@ -229,7 +397,10 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   mapping = std::make_unique<dealii::MappingFE<3>>(dealii::FE_SimplexP<3>(1));
   cell_quadrature = std::make_unique<dealii::QGaussSimplex<3>>(static_cast<unsigned>(settings.degree + 1));
   face_quadrature = std::make_unique<dealii::QGaussSimplex<2>>(static_cast<unsigned>(settings.degree + 1));
-  dof.reinit(tria);
+  if (distributed)
+    dof.reinit(*distributed_tria);
+  else
+    dof.reinit(tria);
   dof.distribute_dofs(*fe);
 
   // Support points; the node-major layout (3k + component) the AMG's block size relies on.
@@ -238,6 +409,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     std::vector<dealii::types::global_dof_index> local(fe->n_dofs_per_cell());
     const auto& unit_points = fe->get_unit_support_points();
     for (const auto& cell : dof.active_cell_iterators()) {
+      if (cell->is_artificial()) continue; // distributed: neither owned nor ghost
       cell->get_dof_indices(local);
       for (unsigned i = 0; i < local.size(); ++i) {
         support[local[i]] = mapping->transform_unit_to_real_cell(cell, unit_points[i]);
@@ -283,6 +455,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
       std::vector<dealii::types::global_dof_index> local(fe->n_dofs_per_face());
       for (const auto& cell : dof.active_cell_iterators())
         for (const unsigned f : cell->face_indices()) {
+          if (cell->is_artificial()) break;
           if (!cell->face(f)->at_boundary() || !in_group(cell->face(f)->boundary_id(), group)) continue;
           cell->face(f)->get_dof_indices(local);
           for (unsigned i = 0; i < local.size(); ++i) {
@@ -300,142 +473,155 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     dealii::FEFaceValues<3> fv(*mapping, *fe, *face_quadrature, dealii::update_JxW_values);
     for (const auto& cell : dof.active_cell_iterators())
       for (const unsigned f : cell->face_indices())
-        if (cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), group)) {
+        if (cell->is_locally_owned() && cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), group)) {
           fv.reinit(cell, f);
           for (unsigned q = 0; q < fv.n_quadrature_points; ++q) area += fv.JxW(q);
         }
+    area = sum(area);
     if (!(area > 0.0)) throw std::invalid_argument("finite strain solver: traction surface '" + t.surface + "' has no area");
     tractions.emplace_back(group, t.total_force / area);
   }
+
+  // `tria` is the whole (refined) mesh on every process, so every process finds the same h_min.
+  h_min = std::numeric_limits<double>::infinity();
+  for (const auto& cell : tria.active_cell_iterators())
+    for (unsigned l = 0; l < cell->n_lines(); ++l) h_min = std::min(h_min, cell->line(l)->diameter());
 
   tool = problem.tool;
   if (tool) {
     validate(*tool);
     penalty = settings.contact_penalty;
-    double h_min = std::numeric_limits<double>::infinity();
-    for (const auto& cell : tria.active_cell_iterators())
-      for (unsigned l = 0; l < cell->n_lines(); ++l) h_min = std::min(h_min, cell->line(l)->diameter());
-    if (penalty <= 0.0) {
-      // ε_N = 50 E_max / h_min: a pressure E costs a penetration of h_min / 50.
-      penalty = 50.0 * *std::max_element(youngs.begin(), youngs.end()) / h_min;
-    }
-    if (tool->kind == RigidToolShape::Kind::wedge) build_blade_edge(support, h_min);
+    // ε_N = 50 E_max / h_min: a pressure E costs a penetration of h_min / 50.
+    if (penalty <= 0.0) penalty = 50.0 * *std::max_element(youngs.begin(), youngs.end()) / h_min;
+    if (tool->kind == RigidToolShape::Kind::wedge) build_blade_edge();
   }
 
-  dealii::AffineConstraints<double> structure;
-  for (const auto& d : dirichlet) structure.add_line(d.index);
-  structure.close();
-  dealii::DynamicSparsityPattern dsp(dof.n_dofs());
-  dealii::DoFTools::make_sparsity_pattern(dof, dsp, structure, false);
-  pattern.copy_from(dsp);
-  K.reinit(pattern);
-  u.reinit(dof.n_dofs());
+  if (problem.cohesive) {
+    if (distributed)
+      throw std::invalid_argument("finite strain solver: the cohesive interface runs on one process for now "
+                                  "(run without mpirun, or with -np 1)");
+    build_cohesive(*problem.cohesive, group_of(problem.cohesive->plus_surface, "cohesive"),
+                   group_of(problem.cohesive->minus_surface, "cohesive"));
+  }
 
   const bool direct = settings.linear_solver == LinearSolverChoice::direct ||
                       (settings.linear_solver == LinearSolverChoice::automatic && dof.n_dofs() <= settings.direct_dof_limit);
-  linear = std::make_unique<TangentSolver>(direct ? TangentSolver::Kind::direct : TangentSolver::Kind::iterative,
-                                           std::move(support), settings.iterative_tolerance);
-}
-
-void FiniteStrainSolver::Impl::build_blade_edge(const std::vector<dealii::Point<3>>& support, double h_min) {
-  node_positions.resize(dof.n_dofs() / 3);
-  for (std::size_t k = 0; k < node_positions.size(); ++k) node_positions[k] = to_eigen(support[3 * k]);
-  auto node = [](dealii::types::global_dof_index i) { return static_cast<int>(i / 3); };
-  double longest = 0.0;
-  for (const auto& cell : dof.active_cell_iterators())
-    for (const unsigned f : cell->face_indices()) {
-      if (!cell->face(f)->at_boundary()) continue;
-      const auto face = cell->face(f);
-      std::array<int, 3> v{node(face->vertex_dof_index(0, 0)), node(face->vertex_dof_index(1, 0)),
-                           node(face->vertex_dof_index(2, 0))};
-      std::array<unsigned, 3> vi{face->vertex_index(0), face->vertex_index(1), face->vertex_index(2)};
-      // Outward: (x1 − x0) × (x2 − x0) points away from the cell's centre.
-      const Eigen::Vector3d x0 = node_positions[static_cast<std::size_t>(v[0])];
-      const Eigen::Vector3d n = (node_positions[static_cast<std::size_t>(v[1])] - x0)
-                                    .cross(node_positions[static_cast<std::size_t>(v[2])] - x0);
-      if (n.dot(x0 - to_eigen(cell->center())) < 0.0) {
-        std::swap(v[1], v[2]);
-        std::swap(vi[1], vi[2]);
-      }
-      for (int a = 0; a < 3; ++a)
-        longest = std::max(longest, (node_positions[static_cast<std::size_t>(v[static_cast<std::size_t>(a)])] -
-                                     node_positions[static_cast<std::size_t>(v[static_cast<std::size_t>((a + 1) % 3)])])
-                                        .norm());
-      if (settings.degree == 1) {
-        facets.push_back(v);
-        continue;
-      }
-      // P2: the midpoint node of the edge (vi[a], vi[a+1]) is m[a]; four flat sub-facets, each
-      // oriented as the face.
-      std::array<int, 3> m{-1, -1, -1};
-      for (unsigned l = 0; l < 3; ++l) {
-        const auto line = face->line(l);
-        for (std::size_t a = 0; a < 3; ++a) {
-          const unsigned p = vi[a], q = vi[(a + 1) % 3];
-          if ((line->vertex_index(0) == p && line->vertex_index(1) == q) ||
-              (line->vertex_index(0) == q && line->vertex_index(1) == p))
-            m[a] = node(line->dof_index(0));
-        }
-      }
-      if (std::find(m.begin(), m.end(), -1) != m.end())
-        throw std::logic_error("finite strain solver: a P2 boundary face without its edge midpoint nodes");
-      facets.push_back({v[0], m[0], m[2]});
-      facets.push_back({m[0], v[1], m[1]});
-      facets.push_back({m[2], m[1], v[2]});
-      facets.push_back({m[0], m[1], m[2]});
-    }
-  // ε_L = ε_N h_min (a line load E h_min costs a penetration h_min / 50 with the automatic ε_N)
-  edge_settings.line_penalty = settings.edge_line_penalty > 0.0 ? settings.edge_line_penalty : penalty * h_min;
-  edge_settings.point_spacing = settings.edge_point_spacing > 0.0 ? settings.edge_point_spacing : 0.25 * h_min;
-  // Facets farther than two boundary edges from an edge point cannot hold its closest point once
-  // the edge has entered the body by less than that in one load increment.
-  edge_settings.search_distance = 2.0 * longest;
-}
-
-void FiniteStrainSolver::Impl::add_blade_edge_contact(const dealii::Vector<double>& state, const LoadState& load,
-                                                      bool with_matrix, Assembly& out,
-                                                      const dealii::AffineConstraints<double>* constraints,
-                                                      dealii::Vector<double>* rhs, dealii::Vector<double>& f_ext) {
-  const BladeEdgeContact c =
-      blade_edge_contact(*tool, load.tool_position, facets, node_positions,
-                         std::span<const double>(state.begin(), state.size()), edge_settings);
-  dealii::FullMatrix<double> term_K(9, 9);
-  dealii::Vector<double> term_f(9);
-  std::vector<dealii::types::global_dof_index> term_dofs(9);
-  for (const EdgeContactTerm& t : c.terms) {
-    for (unsigned i = 0; i < 9; ++i) {
-      term_dofs[i] = 3 * static_cast<dealii::types::global_dof_index>(t.nodes[i / 3]) + i % 3;
-      term_f(i) = t.force_on_body(i);
-      f_ext(term_dofs[i]) += t.force_on_body(i);
-      for (unsigned j = 0; j < 9; ++j) term_K(i, j) = t.stiffness(i, j);
-    }
-    // K += ∂²W/∂x², rhs += f (rhs = f_ext − f_int)
-    if (with_matrix) constraints->distribute_local_to_global(term_K, term_f, term_dofs, K, *rhs);
+  const auto kind = direct ? TangentSolver::Kind::direct : TangentSolver::Kind::iterative;
+  if (!distributed) {
+    dealii::AffineConstraints<double> structure;
+    for (const auto& d : dirichlet) structure.add_line(d.index);
+    structure.close();
+    dealii::DynamicSparsityPattern dsp(dof.n_dofs());
+    dealii::DoFTools::make_sparsity_pattern(dof, dsp, structure, false);
+    for (const CohesivePair& pair : cohesive_pairs) // the interface couples the two cells' DOFs
+      for (const auto i : pair.dofs)
+        for (const auto j : pair.dofs)
+          if (!structure.is_constrained(i) && !structure.is_constrained(j)) dsp.add(i, j);
+    serial.n = dof.n_dofs();
+    serial.pattern.copy_from(dsp);
+    serial.K.reinit(serial.pattern);
+    serial.u.reinit(dof.n_dofs());
+    serial.free_mask.reinit(dof.n_dofs());
+    serial.free_mask = 1.0;
+    for (const auto& d : dirichlet) serial.free_mask[d.index] = 0.0;
+    linear = std::make_unique<TangentSolver>(kind, std::move(support), settings.iterative_tolerance);
+    return;
   }
-  out.contact_on_body += c.force_on_body;
-  out.edge_points = c.active_points;
-  out.edge_length = c.contact_length;
-  out.max_line_load = c.max_line_load;
+  // Distributed: this process's rows (locally owned DOFs) and the DOFs its cells touch
+  // (locally relevant: owned and ghost cells); the sparsity rows other processes contribute to
+  // are sent to their owners.
+  DistributedAlgebra& la = *parallel;
+  la.owned = dof.locally_owned_dofs();
+  dealii::DoFTools::extract_locally_relevant_dofs(dof, la.relevant);
+  if (!la.owned.is_contiguous())
+    throw std::logic_error("finite strain solver: the locally owned DOFs are not one contiguous range");
+  dealii::AffineConstraints<double> structure(la.relevant);
+  for (const auto& d : dirichlet) structure.add_line(d.index);
+  structure.close();
+  dealii::DynamicSparsityPattern dsp(la.relevant);
+  dealii::DoFTools::make_sparsity_pattern(dof, dsp, structure, false);
+  dealii::SparsityTools::distribute_sparsity_pattern(dsp, la.owned, la.comm, la.relevant);
+  la.K.reinit(la.owned, la.owned, dsp, la.comm);
+  la.reinit(la.u);
+  la.ghost.reinit(la.owned, la.relevant, la.comm);
+  la.reinit(la.free_mask);
+  la.free_mask = 1.0;
+  std::vector<dealii::types::global_dof_index> fixed_owned;
+  for (const auto& d : dirichlet)
+    if (la.owns(d.index)) fixed_owned.push_back(d.index);
+  la.free_mask.set(fixed_owned, std::vector<double>(fixed_owned.size(), 0.0));
+  la.free_mask.compress(dealii::VectorOperation::insert);
+  std::vector<dealii::Point<3>> owned_support;
+  for (const auto i : la.owned) owned_support.push_back(support[i]);
+  linear = std::make_unique<TangentSolver>(kind, std::move(owned_support), settings.iterative_tolerance, true);
 }
 
-void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
-                                        Assembly& out, const dealii::AffineConstraints<double>* constraints,
-                                        dealii::Vector<double>* rhs) {
-  const unsigned n = fe->n_dofs_per_cell();
-  out.residual.reinit(dof.n_dofs());
-  dealii::Vector<double> f_int(dof.n_dofs()), f_ext(dof.n_dofs());
+template <class Algebra>
+void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::VectorType& owned_state,
+                                        const LoadState& load, bool with_matrix,
+                                        Assembly<typename Algebra::VectorType>& out,
+                                        const dealii::AffineConstraints<double>* constraints,
+                                        typename Algebra::VectorType* rhs) {
+  typename Algebra::VectorType f_int, f_ext;
+  la.reinit(f_int);
+  la.reinit(f_ext);
+  la.reinit(out.residual);
   out.contact_on_body.setZero();
   out.traction_on_body.setZero();
   out.contact_points = 0;
   out.contact_area = 0.0;
   out.max_pressure = 0.0;
+  if (with_matrix) {
+    la.K = 0.0;
+    *rhs = 0.0;
+  }
+  // An element that fails on one process fails the assembly on every process (after the
+  // collective compress), so that all of them take the same branch of Newton and line search.
+  std::string failure;
+  try {
+    assemble_cells(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_int, f_ext);
+  } catch (const FiniteStrainError& e) {
+    failure = e.what();
+  }
   out.edge_points = 0;
   out.edge_length = 0.0;
   out.max_line_load = 0.0;
+  if (blade_edge) assemble_blade_edge(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_ext);
   if (with_matrix) {
-    K = 0.0;
-    *rhs = 0.0;
+    la.K.compress(dealii::VectorOperation::add);
+    rhs->compress(dealii::VectorOperation::add);
   }
+  f_int.compress(dealii::VectorOperation::add);
+  f_ext.compress(dealii::VectorOperation::add);
+  if (max(failure.empty() ? 0.0 : 1.0) > 0.0)
+    throw FiniteStrainError(failure.empty() ? "finite strain: an element of another process failed" : failure);
+  // The contact and traction tallies of every process's cells.
+  std::array<double, 10> tally{out.contact_on_body.x(), out.contact_on_body.y(), out.contact_on_body.z(),
+                               out.traction_on_body.x(), out.traction_on_body.y(), out.traction_on_body.z(),
+                               static_cast<double>(out.contact_points), out.contact_area,
+                               static_cast<double>(out.edge_points), out.edge_length};
+  sum(tally);
+  out.contact_on_body = Eigen::Vector3d(tally[0], tally[1], tally[2]);
+  out.traction_on_body = Eigen::Vector3d(tally[3], tally[4], tally[5]);
+  out.contact_points = static_cast<int>(tally[6]);
+  out.contact_area = tally[7];
+  out.edge_points = static_cast<int>(tally[8]);
+  out.edge_length = tally[9];
+  out.max_pressure = max(out.max_pressure);
+  out.max_line_load = max(out.max_line_load);
+  out.residual = f_int;
+  out.residual -= f_ext;
+  out.internal_norm = f_int.l2_norm();
+  out.external_norm = f_ext.l2_norm();
+  if (!std::isfinite(out.residual.l2_norm())) throw FiniteStrainError("finite strain: non-finite residual");
+}
+
+template <class VectorType, class MatrixType, class Tally>
+void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const LoadState& load, bool with_matrix,
+                                              Tally& out, const dealii::AffineConstraints<double>* constraints,
+                                              MatrixType& K, VectorType* rhs, VectorType& f_int,
+                                              VectorType& f_ext) const {
+  const unsigned n = fe->n_dofs_per_cell();
   dealii::FEValues<3> fv(*mapping, *fe, *cell_quadrature,
                          dealii::update_gradients | dealii::update_JxW_values);
   dealii::FEFaceValues<3> ffv(*mapping, *fe, *face_quadrature,
@@ -452,6 +638,7 @@ void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, con
   std::vector<Eigen::Matrix<double, 9, 1>> AgradN(n);
 
   for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue; // distributed: another process assembles it
     fv.reinit(cell);
     cell->get_dof_indices(local);
     cell_K = 0.0;
@@ -495,6 +682,7 @@ void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, con
       if (traction == nullptr && !tool) continue;
       ffv.reinit(cell, f);
       if (tool) ffv[disp].get_function_values(state, face_u);
+      const Eigen::Vector3d side = crack_side(cell, f);
       for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
         const double JxW = ffv.JxW(q);
         Eigen::Vector3d t = Eigen::Vector3d::Zero();
@@ -505,7 +693,7 @@ void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, con
         Eigen::Matrix3d dt_dx = Eigen::Matrix3d::Zero();
         if (tool) {
           const Eigen::Vector3d x = to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
-          const ToolContactPoint c = tool_contact(*tool, load.tool_position, x);
+          const ToolContactPoint c = tool_contact(*tool, load.tool_position, x, side);
           if (c.inside) {
             // t_c = ε_N p n (per unit reference area), p = −g
             const Eigen::Vector3d tc = penalty * c.penetration * c.normal;
@@ -528,21 +716,310 @@ void FiniteStrainSolver::Impl::assemble(const dealii::Vector<double>& state, con
         }
       }
     }
-    for (unsigned i = 0; i < n; ++i) {
-      f_int(local[i]) += cell_int(i);
-      f_ext(local[i]) += cell_ext(i);
-    }
+    f_int.add(local, cell_int);
+    f_ext.add(local, cell_ext);
     if (with_matrix) {
       for (unsigned i = 0; i < n; ++i) cell_rhs(i) = cell_ext(i) - cell_int(i);
       constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
     }
   }
-  if (!facets.empty()) add_blade_edge_contact(state, load, with_matrix, out, constraints, rhs, f_ext);
-  out.residual = f_int;
-  out.residual -= f_ext;
-  out.internal_norm = f_int.l2_norm();
-  out.external_norm = f_ext.l2_norm();
-  if (!std::isfinite(out.residual.l2_norm())) throw FiniteStrainError("finite strain: non-finite residual");
+  if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);
+}
+
+void FiniteStrainSolver::Impl::build_blade_edge() {
+  // This process's boundary facets, each as three global node numbers k (DOFs 3k + c, checked
+  // node-major in build), outward: (X1 − X0) × (X2 − X0) points away from the cell's centre.
+  std::vector<double> facets_here; // 3 nodes per facet
+  std::map<dealii::types::global_dof_index, Eigen::Vector3d> nodes_here;
+  auto node = [](dealii::types::global_dof_index i) { return i / 3; };
+  for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue;
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary()) continue;
+      const auto face = cell->face(f);
+      std::array<dealii::types::global_dof_index, 3> v{};
+      std::array<unsigned, 3> vi{};
+      for (unsigned a = 0; a < 3; ++a) {
+        v[a] = node(face->vertex_dof_index(a, 0));
+        vi[a] = face->vertex_index(a);
+        nodes_here[v[a]] = to_eigen(face->vertex(a));
+      }
+      const Eigen::Vector3d X0 = nodes_here[v[0]];
+      const Eigen::Vector3d n = (nodes_here[v[1]] - X0).cross(nodes_here[v[2]] - X0);
+      if (n.dot(X0 - to_eigen(cell->center())) < 0.0) {
+        std::swap(v[1], v[2]);
+        std::swap(vi[1], vi[2]);
+      }
+      auto add = [&](dealii::types::global_dof_index a, dealii::types::global_dof_index b,
+                     dealii::types::global_dof_index c) {
+        for (const auto k : {a, b, c}) facets_here.push_back(static_cast<double>(k));
+      };
+      if (settings.degree == 1) {
+        add(v[0], v[1], v[2]);
+        continue;
+      }
+      // P2: m[a] is the midpoint node of the edge (vi[a], vi[a+1]); four flat sub-facets, each
+      // oriented as the face.
+      std::array<dealii::types::global_dof_index, 3> m{};
+      std::array<bool, 3> found{false, false, false};
+      for (unsigned l = 0; l < 3; ++l) {
+        const auto line = face->line(l);
+        for (std::size_t a = 0; a < 3; ++a) {
+          const unsigned p = vi[a], q = vi[(a + 1) % 3];
+          if ((line->vertex_index(0) == p && line->vertex_index(1) == q) ||
+              (line->vertex_index(0) == q && line->vertex_index(1) == p)) {
+            m[a] = node(line->dof_index(0));
+            nodes_here[m[a]] = to_eigen(line->center()); // straight-sided cells (MappingFE of P1)
+            found[a] = true;
+          }
+        }
+      }
+      if (!(found[0] && found[1] && found[2]))
+        throw std::logic_error("finite strain solver: a P2 boundary face without its edge midpoint nodes");
+      add(v[0], m[0], m[2]);
+      add(m[0], v[1], m[1]);
+      add(m[2], m[1], v[2]);
+      add(m[0], m[1], m[2]);
+    }
+  }
+  // Every process's facets and nodes (rank order): 3 numbers per facet; 4 per node (k, X).
+  std::vector<double> my_nodes;
+  for (const auto& [k, X] : nodes_here) my_nodes.insert(my_nodes.end(), {static_cast<double>(k), X.x(), X.y(), X.z()});
+  std::vector<std::vector<double>> all_facets{facets_here}, all_nodes{my_nodes};
+  if (distributed) {
+    all_facets = all_gather(parallel->comm, facets_here);
+    all_nodes = all_gather(parallel->comm, my_nodes);
+  }
+  const int here = distributed ? rank : 0;
+  BladeEdgeBoundary b;
+  std::map<dealii::types::global_dof_index, int> compact;
+  for (std::size_t r = 0; r < all_nodes.size(); ++r)
+    for (std::size_t i = 0; i + 3 < all_nodes[r].size(); i += 4) {
+      const auto k = static_cast<dealii::types::global_dof_index>(all_nodes[r][i]);
+      if (compact.count(k) != 0) continue; // the first process holding a node supplies it
+      compact.emplace(k, static_cast<int>(b.node_of.size()));
+      b.node_of.push_back(k);
+      b.positions.emplace_back(all_nodes[r][i + 1], all_nodes[r][i + 2], all_nodes[r][i + 3]);
+      b.node_here.push_back(static_cast<int>(r) == here ? 1 : 0);
+    }
+  double longest = 0.0;
+  for (std::size_t r = 0; r < all_facets.size(); ++r)
+    for (std::size_t i = 0; i + 2 < all_facets[r].size(); i += 3) {
+      BoundaryFacet facet{};
+      for (std::size_t a = 0; a < 3; ++a)
+        facet[a] = compact.at(static_cast<dealii::types::global_dof_index>(all_facets[r][i + a]));
+      for (std::size_t a = 0; a < 3; ++a)
+        longest = std::max(longest, (b.positions[static_cast<std::size_t>(facet[a])] -
+                                     b.positions[static_cast<std::size_t>(facet[(a + 1) % 3])]).norm());
+      b.facets.push_back(facet);
+      b.facet_here.push_back(static_cast<int>(r) == here ? 1 : 0);
+    }
+  // ε_L = ε_N h_min (a line load E h_min costs a penetration h_min / 50 with the automatic ε_N)
+  b.settings.line_penalty = settings.edge_line_penalty > 0.0 ? settings.edge_line_penalty : penalty * h_min;
+  b.settings.point_spacing = settings.edge_point_spacing > 0.0 ? settings.edge_point_spacing : 0.25 * h_min;
+  // Facets farther than two boundary edges from an edge point cannot hold its closest point once
+  // the edge has entered the body by less than that in one load increment.
+  b.settings.search_distance = 2.0 * longest;
+  b.displacement.assign(3 * b.node_of.size(), 0.0);
+  blade_edge = std::move(b);
+}
+
+template <class VectorType, class MatrixType, class Tally>
+void FiniteStrainSolver::Impl::assemble_blade_edge(const VectorType& state, const LoadState& load, bool with_matrix,
+                                                   Tally& out, const dealii::AffineConstraints<double>* constraints,
+                                                   MatrixType& K, VectorType* rhs, VectorType& f_ext) const {
+  const BladeEdgeBoundary& b = *blade_edge;
+  // The boundary nodes' displacements, each supplied by one process (collective when distributed).
+  std::fill(b.displacement.begin(), b.displacement.end(), 0.0);
+  for (std::size_t k = 0; k < b.node_of.size(); ++k)
+    if (b.node_here[k] != 0)
+      for (unsigned c = 0; c < 3; ++c) b.displacement[3 * k + c] = state[3 * b.node_of[k] + c];
+  sum(b.displacement);
+  const BladeEdgeContact contact =
+      blade_edge_contact(*tool, load.tool_position, b.facets, b.positions, b.displacement, b.settings);
+  dealii::FullMatrix<double> term_K(9, 9);
+  dealii::Vector<double> term_f(9);
+  std::vector<dealii::types::global_dof_index> term_dofs(9);
+  for (const EdgeContactTerm& t : contact.terms) {
+    if (b.facet_here[t.facet] == 0) continue; // another process's facet
+    for (unsigned i = 0; i < 9; ++i) {
+      term_dofs[i] = 3 * b.node_of[static_cast<std::size_t>(t.nodes[i / 3])] + i % 3;
+      term_f(i) = t.force_on_body(i);
+      for (unsigned j = 0; j < 9; ++j) term_K(i, j) = t.stiffness(i, j);
+    }
+    f_ext.add(term_dofs, term_f);
+    // K += ∂²W/∂x², rhs += f (rhs = f_ext − f_int)
+    if (with_matrix) constraints->distribute_local_to_global(term_K, term_f, term_dofs, K, *rhs);
+    for (int i = 0; i < 3; ++i) out.contact_on_body += t.force_on_body.template segment<3>(3 * i);
+    ++out.edge_points;
+    out.edge_length += t.weight;
+    out.max_line_load = std::max(out.max_line_load, t.line_load);
+  }
+}
+
+void FiniteStrainSolver::Impl::build_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group) {
+  validate(spec.law);
+  if (spec.plus_surface == spec.minus_surface)
+    throw std::invalid_argument("finite strain solver: cohesive plus and minus surfaces are the same group '" + spec.plus_surface + "'");
+  const unsigned n = fe->n_dofs_per_cell();
+  cell_components.resize(n);
+  for (unsigned i = 0; i < n; ++i) cell_components[i] = fe->system_to_component_index(i).first;
+
+  // Coincident faces are found by their vertex positions, rounded on a grid far finer than any
+  // element (the copies made by the crack split, and their refinements, coincide exactly).
+  const double grid = 1e-6 * h_min;
+  using Key = std::array<long long, 9>;
+  auto key_of = [&](const auto& face) {
+    std::array<std::array<long long, 3>, 3> v{};
+    for (unsigned k = 0; k < 3; ++k)
+      for (unsigned c = 0; c < 3; ++c) v[k][c] = std::llround(face->vertex(k)[c] / grid);
+    std::sort(v.begin(), v.end());
+    Key key{};
+    for (unsigned k = 0; k < 3; ++k)
+      for (unsigned c = 0; c < 3; ++c) key[3 * k + c] = v[k][c];
+    return key;
+  };
+  std::map<Key, std::pair<dealii::DoFHandler<3>::active_cell_iterator, unsigned>> minus_faces;
+  for (const auto& cell : dof.active_cell_iterators())
+    for (const unsigned f : cell->face_indices())
+      if (cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), minus_group))
+        minus_faces[key_of(cell->face(f))] = {cell, f};
+
+  dealii::FEFaceValues<3> ffv(*mapping, *fe, *face_quadrature,
+                              dealii::update_values | dealii::update_quadrature_points | dealii::update_JxW_values |
+                                  dealii::update_normal_vectors);
+  std::vector<dealii::types::global_dof_index> plus_dofs(n), minus_dofs(n);
+  for (const auto& cell : dof.active_cell_iterators())
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary() || !in_group(cell->face(f)->boundary_id(), plus_group)) continue;
+      const auto match = minus_faces.find(key_of(cell->face(f)));
+      if (match == minus_faces.end())
+        throw std::invalid_argument("finite strain solver: a face of cohesive surface '" + spec.plus_surface + "' at (" +
+                                    std::to_string(cell->face(f)->center()[0]) + ", " + std::to_string(cell->face(f)->center()[1]) +
+                                    ", " + std::to_string(cell->face(f)->center()[2]) + ") m has no coincident face in '" +
+                                    spec.minus_surface + "' (was the mesh split along the crack path?)");
+      const auto minus_cell = match->second.first;
+      ffv.reinit(cell, f);
+      CohesivePair pair;
+      cell->get_dof_indices(plus_dofs);
+      minus_cell->get_dof_indices(minus_dofs);
+      pair.dofs = plus_dofs;
+      pair.dofs.insert(pair.dofs.end(), minus_dofs.begin(), minus_dofs.end());
+      // The + cell's outward normal points into the − side; n points from − into +.
+      pair.normal = -Eigen::Vector3d(ffv.normal_vector(0)[0], ffv.normal_vector(0)[1], ffv.normal_vector(0)[2]);
+      crack_face_sides[4 * cell->active_cell_index() + f] = pair.normal;
+      crack_face_sides[4 * minus_cell->active_cell_index() + match->second.second] = -pair.normal;
+      for (unsigned k = 0; k < 3; ++k) pair.vertices[k] = to_eigen(cell->face(f)->vertex(k));
+      // The − cell's unit coordinates of each quadrature point (affine P1 geometry: ξ = A⁻¹ (x − v₀),
+      // the unit tetrahedron's vertices 1, 2, 3 being e_x, e_y, e_z).
+      Eigen::Matrix3d A;
+      const Eigen::Vector3d v0 = to_eigen(minus_cell->vertex(0));
+      for (unsigned k = 1; k < 4; ++k) A.col(k - 1) = to_eigen(minus_cell->vertex(k)) - v0;
+      const Eigen::Matrix3d A_inv = A.inverse();
+      for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
+        const Eigen::Vector3d x = to_eigen(ffv.quadrature_point(q));
+        const Eigen::Vector3d xi = A_inv * (x - v0);
+        const dealii::Point<3> unit(xi[0], xi[1], xi[2]);
+        std::vector<double> plus(n), minus(n);
+        for (unsigned i = 0; i < n; ++i) {
+          plus[i] = ffv.shape_value_component(i, q, cell_components[i]);
+          minus[i] = fe->shape_value_component(i, unit, cell_components[i]);
+        }
+        pair.plus_values.push_back(std::move(plus));
+        pair.minus_values.push_back(std::move(minus));
+        pair.weights.push_back(ffv.JxW(q));
+        pair.points.push_back(x);
+      }
+      cohesive_pairs.push_back(std::move(pair));
+    }
+  if (cohesive_pairs.empty())
+    throw std::invalid_argument("finite strain solver: cohesive surface '" + spec.plus_surface + "' has no boundary faces");
+  if (cohesive_pairs.size() != minus_faces.size())
+    throw std::invalid_argument("finite strain solver: cohesive surfaces '" + spec.plus_surface + "' and '" + spec.minus_surface +
+                                "' have different face counts (" + std::to_string(cohesive_pairs.size()) + " and " +
+                                std::to_string(minus_faces.size()) + ")");
+  cohesive_law = spec.law;
+  cohesive_states.assign(cohesive_pairs.size() * face_quadrature->size(), CohesiveState{});
+}
+
+template <class VectorType>
+Eigen::Vector3d FiniteStrainSolver::Impl::cohesive_opening(const CohesivePair& pair, std::size_t q,
+                                                          const VectorType& state) const {
+  // Δ = x⁺ − x⁻ = u⁺ − u⁻ at a point where the two faces coincide in the reference configuration.
+  const std::size_t n = cell_components.size();
+  Eigen::Vector3d opening = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < n; ++i) {
+    opening[cell_components[i]] += pair.plus_values[q][i] * state(pair.dofs[i]);
+    opening[cell_components[i]] -= pair.minus_values[q][i] * state(pair.dofs[n + i]);
+  }
+  return opening;
+}
+
+template <class VectorType, class MatrixType>
+void FiniteStrainSolver::Impl::assemble_cohesive(const VectorType& state, const LoadState& load, bool with_matrix,
+                                                 const dealii::AffineConstraints<double>* constraints, MatrixType& K,
+                                                 VectorType* rhs, VectorType& f_int) const {
+  // Interface potential Π = ∫ φ(Δ) dA with Δ = Σ N⁺ u⁺ − Σ N⁻ u⁻: f_int,a = ∫ s_a N_a t dA and
+  // K_ab = ∫ s_a N_a (∂t/∂Δ) s_b N_b dA, s = +1 on the + side and −1 on the − side.
+  const std::size_t n = cell_components.size(), nq = face_quadrature->size();
+  const double dt = load.time - committed_time;
+  dealii::FullMatrix<double> local_K(2 * n, 2 * n);
+  dealii::Vector<double> local_rhs(2 * n), local_f(2 * n);
+  std::vector<double> a(2 * n);
+  std::vector<unsigned> comp(2 * n);
+  for (std::size_t i = 0; i < 2 * n; ++i) comp[i] = cell_components[i % n];
+  for (std::size_t p = 0; p < cohesive_pairs.size(); ++p) {
+    const CohesivePair& pair = cohesive_pairs[p];
+    local_K = 0.0;
+    local_rhs = 0.0;
+    local_f = 0.0;
+    for (std::size_t q = 0; q < nq; ++q) {
+      const CohesiveResponse r =
+          cohesive_response(*cohesive_law, cohesive_states[p * nq + q], cohesive_opening(pair, q, state), pair.normal, dt,
+                            cohesive_secant);
+      const double w = pair.weights[q];
+      for (std::size_t i = 0; i < n; ++i) {
+        a[i] = pair.plus_values[q][i];
+        a[n + i] = -pair.minus_values[q][i];
+      }
+      for (std::size_t i = 0; i < 2 * n; ++i) {
+        if (a[i] == 0.0) continue;
+        const double f = a[i] * r.traction[comp[i]] * w;
+        local_f(static_cast<unsigned>(i)) += f;
+        local_rhs(static_cast<unsigned>(i)) -= f;
+        if (with_matrix)
+          for (std::size_t j = 0; j < 2 * n; ++j)
+            local_K(static_cast<unsigned>(i), static_cast<unsigned>(j)) += a[i] * a[j] * r.tangent(comp[i], comp[j]) * w;
+      }
+    }
+    f_int.add(pair.dofs, local_f);
+    if (with_matrix) constraints->distribute_local_to_global(local_K, local_rhs, pair.dofs, K, *rhs);
+  }
+}
+
+CohesiveSummary FiniteStrainSolver::Impl::commit_cohesive(const LoadState& load) {
+  const std::size_t nq = face_quadrature->size();
+  const double dt = load.time - committed_time;
+  const double d0 = cohesive_law->peak_opening();
+  CohesiveSummary summary;
+  for (std::size_t p = 0; p < cohesive_pairs.size(); ++p)
+    for (std::size_t q = 0; q < nq; ++q) {
+      CohesiveState& state = cohesive_states[p * nq + q];
+      const Eigen::Vector3d opening = cohesive_opening(cohesive_pairs[p], q, serial.u);
+      const CohesiveResponse r = cohesive_response(*cohesive_law, state, opening, cohesive_pairs[p].normal, dt);
+      const double w = cohesive_pairs[p].weights[q];
+      if (dt > 0.0) cohesive_viscous_dissipation += r.viscous_power_density * dt * w;
+      state.max_opening = r.damage_opening;
+      state.previous_opening = opening;
+      if (r.failed) summary.failed_area += w;
+      if (r.damage_opening > d0) summary.damaged_area += w;
+      summary.stored_energy += r.stored_energy * w;
+      summary.dissipated_energy += r.dissipated_energy * w;
+      summary.max_damage = std::max(summary.max_damage, r.damage);
+    }
+  committed_time = load.time;
+  summary.viscous_dissipation = cohesive_viscous_dissipation;
+  return summary;
 }
 
 FiniteStrainSolver::FiniteStrainSolver(const FiniteStrainProblem& problem, const SolverSettings& settings)
@@ -554,13 +1031,20 @@ FiniteStrainSolver::FiniteStrainSolver(const FiniteStrainProblem& problem, const
 FiniteStrainSolver::~FiniteStrainSolver() = default;
 
 EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
-  Impl& m = *m_impl;
+  return m_impl->with_algebra([&](auto& la) { return m_impl->solve(la, load); });
+}
+
+template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algebra& la, const LoadState& load) {
+  using VectorType = typename Algebra::VectorType;
+  Impl& m = *this;
   EquilibriumReport report;
-  const dealii::Vector<double> start = m.u;
-  Impl::Assembly assembly;
-  dealii::Vector<double> rhs(m.dof.n_dofs()), du(m.dof.n_dofs());
+  const VectorType start = la.u;
+  Impl::Assembly<VectorType> assembly;
+  VectorType rhs, du;
+  la.reinit(rhs);
+  la.reinit(du);
   auto fail = [&](std::string why) {
-    m.u = start;
+    la.u = start;
     report.converged = false;
     report.failure = std::move(why);
     return report;
@@ -569,22 +1053,29 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
     for (int it = 0;; ++it) {
       // Constraints of this iteration: the remaining Dirichlet increment target − u.
       dealii::AffineConstraints<double> constraints;
+      la.prepare(constraints);
+      const VectorType& u_relevant = la.ghosted(la.u);
       double mismatch = 0.0;
       for (const auto& d : m.dirichlet) {
-        const double g = m.dirichlet_target(d, load.load_factor) - m.u[d.index];
+        const double g = m.dirichlet_target(d, load.load_factor) - u_relevant[d.index];
         mismatch = std::max(mismatch, std::abs(g));
         constraints.add_line(d.index);
         constraints.set_inhomogeneity(d.index, g);
       }
       constraints.close();
+      mismatch = m.max(mismatch);
+      // A cohesive interface whose points switch between loading and unloading can make the
+      // consistent Newton iteration cycle; after a third of the allowed iterations the secant
+      // interface tangent takes over (slower, but it does not cycle).
+      m.cohesive_secant = m.cohesive_law && it >= m.settings.max_newton_iterations / 3;
       auto t0 = Clock::now();
-      m.assemble(m.u, load, true, assembly, &constraints, &rhs);
+      m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
       report.assembly_seconds += seconds_since(t0);
-      const double r = m.free_norm(assembly.residual);
+      const double r = m.free_norm(assembly.residual, la.free_mask);
       report.residual_history.push_back(r);
       const double scale = assembly.internal_norm + assembly.external_norm;
       const double tol = m.settings.relative_tolerance * scale + m.settings.absolute_tolerance;
-      const double u_scale = std::max(m.u.linfty_norm(), 1e-300);
+      const double u_scale = std::max(la.u.linfty_norm(), 1e-300);
       if (r <= tol && mismatch <= 1e-12 * u_scale + 1e-300) {
         report.converged = true;
         break;
@@ -592,7 +1083,7 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
       if (it >= m.settings.max_newton_iterations)
         return fail("no convergence in " + std::to_string(m.settings.max_newton_iterations) + " Newton iterations");
       t0 = Clock::now();
-      report.linear_iterations += m.linear->solve(m.K, du, rhs);
+      report.linear_iterations += m.linear->solve(la.K, du, rhs);
       report.linear_solve_seconds += seconds_since(t0);
       constraints.distribute(du);
       ++report.newton_iterations;
@@ -600,20 +1091,20 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
       // every element valid and reduces |R|, else the valid α with the smallest |R|. While a
       // Dirichlet increment is pending the residual is no merit function (it starts at zero and
       // must grow with the imposed displacement): then the largest valid α is taken.
-      const dealii::Vector<double> base = m.u;
+      const VectorType base = la.u;
       double best_alpha = 0.0, best_r = std::numeric_limits<double>::infinity();
-      Impl::Assembly trial;
+      Impl::Assembly<VectorType> trial;
       for (double alpha = 1.0; alpha > 1.0 / 64.0; alpha *= 0.5) {
-        m.u = base;
-        m.u.add(alpha, du);
+        la.u = base;
+        la.u.add(alpha, du);
         try {
           t0 = Clock::now();
-          m.assemble(m.u, load, false, trial, nullptr, nullptr);
+          m.assemble(la, la.u, load, false, trial, nullptr, nullptr);
           report.assembly_seconds += seconds_since(t0);
         } catch (const FiniteStrainError&) {
           continue;
         }
-        const double rt = m.free_norm(trial.residual);
+        const double rt = m.free_norm(trial.residual, la.free_mask);
         if (rt < best_r) {
           best_r = rt;
           best_alpha = alpha;
@@ -624,30 +1115,35 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
         }
       }
       if (best_alpha == 0.0) return fail("every line-search step inverts an element");
-      m.u = base;
-      m.u.add(best_alpha, du);
+      la.u = base;
+      la.u.add(best_alpha, du);
     }
   } catch (const FiniteStrainError& e) {
     return fail(e.what());
-  } catch (const std::runtime_error& e) {
+  } catch (const std::exception& e) { // PETSc/UMFPACK errors (deal.II exceptions are std::exception)
     return fail(std::string("linear solver: ") + e.what());
   }
-  // Reactions: the residual on the Dirichlet DOFs is the force the supports put on the body.
-  // The reaction of boundary b is −Σ R over the Dirichlet DOFs assigned to b.
+  // Reactions: the residual R on the Dirichlet DOFs is the force the supports put on the body;
+  // the reaction of boundary b (body on support) is −Σ R over the Dirichlet DOFs assigned to b.
   report.boundary_reactions.resize(m.boundaries.size());
   for (std::size_t b = 0; b < m.boundaries.size(); ++b) report.boundary_reactions[b].surface = m.boundaries[b].surface;
   for (const auto& d : m.dirichlet)
-    report.boundary_reactions[static_cast<std::size_t>(d.boundary)].force[d.component] -= assembly.residual[d.index];
-  for (const BoundaryReaction& b : report.boundary_reactions) report.support_reaction += b.force;
+    if (la.owns(d.index))
+      report.boundary_reactions[static_cast<std::size_t>(d.boundary)].force[d.component] -= assembly.residual[d.index];
+  for (BoundaryReaction& b : report.boundary_reactions) {
+    m.sum(std::span<double>(b.force.data(), 3));
+    report.support_reaction += b.force;
+  }
+  if (m.cohesive_law) report.cohesive = m.commit_cohesive(load);
   report.tool_force = -assembly.contact_on_body;
   report.traction_resultant = assembly.traction_on_body;
   report.force_imbalance = report.traction_resultant - report.tool_force - report.support_reaction;
-  report.contact_points = assembly.contact_points;
-  report.contact_area = assembly.contact_area;
-  report.max_contact_pressure = assembly.max_pressure;
   report.edge_contact_points = assembly.edge_points;
   report.edge_contact_length = assembly.edge_length;
   report.max_edge_line_load = assembly.max_line_load;
+  report.contact_points = assembly.contact_points;
+  report.contact_area = assembly.contact_area;
+  report.max_contact_pressure = assembly.max_pressure;
   return report;
 }
 
@@ -655,33 +1151,61 @@ std::size_t FiniteStrainSolver::dof_count() const { return m_impl->dof.n_dofs();
 std::size_t FiniteStrainSolver::cell_count() const { return m_impl->tria.n_active_cells(); }
 std::string FiniteStrainSolver::linear_solver_name() const { return m_impl->linear->name(); }
 double FiniteStrainSolver::contact_penalty() const { return m_impl->penalty; }
+std::size_t FiniteStrainSolver::cohesive_point_count() const { return m_impl->cohesive_states.size(); }
+double FiniteStrainSolver::crack_extent(const Eigen::Vector3d& direction) const {
+  const Impl& m = *m_impl;
+  if (!m.cohesive_law) return 0.0;
+  const std::size_t nq = m.face_quadrature->size();
+  const double df = m.cohesive_law->failure_opening();
+  double first = std::numeric_limits<double>::infinity(), reach = -std::numeric_limits<double>::infinity();
+  for (std::size_t p = 0; p < m.cohesive_pairs.size(); ++p) {
+    for (const Eigen::Vector3d& v : m.cohesive_pairs[p].vertices) first = std::min(first, v.dot(direction));
+    for (std::size_t q = 0; q < nq; ++q)
+      if (m.cohesive_states[p * nq + q].max_opening >= df) reach = std::max(reach, m.cohesive_pairs[p].points[q].dot(direction));
+  }
+  return reach > first ? reach - first : 0.0;
+}
 double FiniteStrainSolver::max_displacement() const {
   double best = 0.0;
-  const auto& u = m_impl->u;
+  const std::vector<double> u = state();
   for (std::size_t k = 0; k + 2 < u.size(); k += 3)
     best = std::max(best, std::sqrt(u[k] * u[k] + u[k + 1] * u[k + 1] + u[k + 2] * u[k + 2]));
   return best;
 }
 
+int FiniteStrainSolver::process_count() const { return m_impl->distributed ? m_impl->process_count : 1; }
+
 Eigen::Vector3d FiniteStrainSolver::displacement_at(const Eigen::Vector3d& X) const {
   const Impl& m = *m_impl;
-  // The cell whose barycentric coordinates of X are all >= −tol (straight-sided tetrahedra).
-  for (const auto& cell : m.dof.active_cell_iterators()) {
-    Eigen::Matrix3d A;
-    const Eigen::Vector3d v0 = to_eigen(cell->vertex(0));
-    for (unsigned k = 1; k < 4; ++k) A.col(k - 1) = to_eigen(cell->vertex(k)) - v0;
-    const Eigen::Vector3d xi = A.lu().solve(X - v0);
-    const double tol = 1e-10;
-    if (xi.minCoeff() < -tol || xi.sum() > 1.0 + tol) continue;
-    // The unit tetrahedron's vertices 1, 2, 3 are e_x, e_y, e_z: the unit point is ξ itself.
-    const dealii::Quadrature<3> point(dealii::Point<3>(xi[0], xi[1], xi[2]));
-    dealii::FEValues<3> fv(*m.mapping, *m.fe, point, dealii::update_values);
-    fv.reinit(cell);
-    std::vector<dealii::Vector<double>> value(1, dealii::Vector<double>(3));
-    fv.get_function_values(m.u, value);
-    return {value[0][0], value[0][1], value[0][2]};
-  }
-  throw std::out_of_range("displacement_at: the point lies outside the mesh");
+  std::optional<Eigen::Vector3d> found;
+  m.with_algebra([&](const auto& la) {
+    const auto& u = la.ghosted(la.u);
+    // The cell whose barycentric coordinates of X are all >= −tol (straight-sided tetrahedra).
+    for (const auto& cell : m.dof.active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      Eigen::Matrix3d A;
+      const Eigen::Vector3d v0 = to_eigen(cell->vertex(0));
+      for (unsigned k = 1; k < 4; ++k) A.col(k - 1) = to_eigen(cell->vertex(k)) - v0;
+      const Eigen::Vector3d xi = A.lu().solve(X - v0);
+      const double tol = 1e-10;
+      if (xi.minCoeff() < -tol || xi.sum() > 1.0 + tol) continue;
+      // The unit tetrahedron's vertices 1, 2, 3 are e_x, e_y, e_z: the unit point is ξ itself.
+      const dealii::Quadrature<3> point(dealii::Point<3>(xi[0], xi[1], xi[2]));
+      dealii::FEValues<3> fv(*m.mapping, *m.fe, point, dealii::update_values);
+      fv.reinit(cell);
+      std::vector<dealii::Vector<double>> value(1, dealii::Vector<double>(3));
+      fv.get_function_values(u, value);
+      found = Eigen::Vector3d(value[0][0], value[0][1], value[0][2]);
+      return;
+    }
+  });
+  // Distributed: the lowest rank whose cells hold X answers.
+  const double owner = -m.max(found ? -static_cast<double>(m.rank) : -static_cast<double>(INT_MAX));
+  if (owner == static_cast<double>(INT_MAX))
+    throw std::out_of_range("displacement_at: the point lies outside the mesh");
+  Eigen::Vector3d value = found && owner == static_cast<double>(m.rank) ? *found : Eigen::Vector3d::Zero();
+  m.sum(std::span<double>(value.data(), 3));
+  return value;
 }
 
 std::vector<Eigen::Matrix3d> FiniteStrainSolver::quadrature_cauchy_stresses() const {
@@ -689,26 +1213,90 @@ std::vector<Eigen::Matrix3d> FiniteStrainSolver::quadrature_cauchy_stresses() co
   std::vector<Eigen::Matrix3d> out;
   dealii::FEValues<3> fv(*m.mapping, *m.fe, *m.cell_quadrature, dealii::update_gradients);
   std::vector<dealii::Tensor<2, 3>> grads(m.cell_quadrature->size());
-  for (const auto& cell : m.dof.active_cell_iterators()) {
-    fv.reinit(cell);
-    fv[dealii::FEValuesExtractors::Vector(0)].get_function_gradients(m.u, grads);
-    for (const auto& g : grads) {
-      const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(g);
-      out.push_back(cauchy_stress(F, m.laws[cell->material_id()]->stress_and_tangent(F).first_piola));
+  m.with_algebra([&](const auto& la) {
+    const auto& u = la.ghosted(la.u);
+    for (const auto& cell : m.dof.active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      fv.reinit(cell);
+      fv[dealii::FEValuesExtractors::Vector(0)].get_function_gradients(u, grads);
+      for (const auto& g : grads) {
+        const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(g);
+        out.push_back(cauchy_stress(F, m.laws[cell->material_id()]->stress_and_tangent(F).first_piola));
+      }
     }
-  }
+  });
   return out;
 }
 
+double FiniteStrainSolver::strain_energy() const {
+  const Impl& m = *m_impl;
+  return m.with_algebra([&](const auto& la) {
+    const auto& u = la.ghosted(la.u);
+    dealii::FEValues<3> fv(*m.mapping, *m.fe, *m.cell_quadrature, dealii::update_gradients | dealii::update_JxW_values);
+    std::vector<dealii::Tensor<2, 3>> grads(m.cell_quadrature->size());
+    double energy = 0.0;
+    for (const auto& cell : m.dof.active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      fv.reinit(cell);
+      fv[dealii::FEValuesExtractors::Vector(0)].get_function_gradients(u, grads);
+      for (unsigned q = 0; q < fv.n_quadrature_points; ++q)
+        energy += m.laws[cell->material_id()]->energy(Eigen::Matrix3d::Identity() + to_eigen(grads[q])) * fv.JxW(q);
+    }
+    return m.sum(energy);
+  });
+}
+
 std::vector<double> FiniteStrainSolver::state() const {
-  return std::vector<double>(m_impl->u.begin(), m_impl->u.end());
+  const Impl& m = *m_impl;
+  std::vector<double> values;
+  if (!m.distributed) {
+    values.assign(m.serial.u.begin(), m.serial.u.end());
+  } else {
+    // Every process's locally owned values in place, summed over the processes.
+    const DistributedAlgebra& la = *m.parallel;
+    std::vector<dealii::types::global_dof_index> indices(la.owned.begin(), la.owned.end());
+    std::vector<double> owned(indices.size());
+    la.u.extract_subvector_to(indices, owned);
+    values.assign(m.dof.n_dofs(), 0.0);
+    for (std::size_t k = 0; k < indices.size(); ++k) values[indices[k]] = owned[k];
+    m.sum(values);
+  }
+  if (m.cohesive_law) { // serial only (build refuses a distributed cohesive interface)
+    for (const CohesiveState& s : m.cohesive_states)
+      values.insert(values.end(), {s.max_opening, s.previous_opening[0], s.previous_opening[1], s.previous_opening[2]});
+    values.push_back(m.committed_time);
+    values.push_back(m.cohesive_viscous_dissipation);
+  }
+  return values;
 }
 
 void FiniteStrainSolver::set_state(const std::vector<double>& values) {
-  if (values.size() != m_impl->u.size())
-    throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values for " +
-                                std::to_string(m_impl->u.size()) + " DOFs");
-  std::copy(values.begin(), values.end(), m_impl->u.begin());
+  Impl& m = *m_impl;
+  const std::size_t n_dofs = m.dof.n_dofs();
+  const std::size_t expected = n_dofs + (m.cohesive_law ? 4 * m.cohesive_states.size() + 2 : 0);
+  if (values.size() != expected)
+    throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values, expected " + std::to_string(expected) +
+                                " (" + std::to_string(n_dofs) + " DOFs" +
+                                (m.cohesive_law ? " + 4 per cohesive point + 2" : std::string()) + ")");
+  if (m.cohesive_law) {
+    auto it = values.begin() + static_cast<std::ptrdiff_t>(n_dofs);
+    for (CohesiveState& s : m.cohesive_states) {
+      s.max_opening = *it++;
+      for (int c = 0; c < 3; ++c) s.previous_opening[c] = *it++;
+    }
+    m.committed_time = *it++;
+    m.cohesive_viscous_dissipation = *it++;
+  }
+  if (!m.distributed) {
+    std::copy(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(n_dofs), m.serial.u.begin());
+    return;
+  }
+  DistributedAlgebra& la = *m.parallel;
+  std::vector<dealii::types::global_dof_index> indices(la.owned.begin(), la.owned.end());
+  std::vector<double> owned(indices.size());
+  for (std::size_t k = 0; k < indices.size(); ++k) owned[k] = values[indices[k]];
+  la.u.set(indices, owned);
+  la.u.compress(dealii::VectorOperation::insert);
 }
 
 namespace {
@@ -746,30 +1334,38 @@ private:
 
 } // namespace
 
-void FiniteStrainSolver::write_fields(const std::filesystem::path& vtu, const LoadState& load) const {
+void FiniteStrainSolver::write_fields(const std::filesystem::path& file, const LoadState& load) const {
   const Impl& m = *m_impl;
+  m.with_algebra([&](const auto& la) { m.write_fields(la.ghosted(la.u), file, load); });
+}
+
+template <class VectorType>
+void FiniteStrainSolver::Impl::write_fields(const VectorType& u, const std::filesystem::path& file,
+                                            const LoadState& load) const {
+  const Impl& m = *this;
+  const unsigned cells = m.dof.get_triangulation().n_active_cells(); // distributed: this process's view
   // Contact pressure per cell: the largest ε_N p over the cell's boundary quadrature points.
-  dealii::Vector<float> pressure(m.tria.n_active_cells()), material(m.tria.n_active_cells());
+  dealii::Vector<float> pressure(cells), material(cells);
   if (m.tool) {
     dealii::FEFaceValues<3> ffv(*m.mapping, *m.fe, *m.face_quadrature,
                                 dealii::update_values | dealii::update_quadrature_points);
     std::vector<dealii::Tensor<1, 3>> face_u(m.face_quadrature->size());
     for (const auto& cell : m.dof.active_cell_iterators())
       for (const unsigned f : cell->face_indices()) {
-        if (!cell->face(f)->at_boundary()) continue;
+        if (!cell->is_locally_owned() || !cell->face(f)->at_boundary()) continue;
         ffv.reinit(cell, f);
-        ffv[dealii::FEValuesExtractors::Vector(0)].get_function_values(m.u, face_u);
+        ffv[dealii::FEValuesExtractors::Vector(0)].get_function_values(u, face_u);
         for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
           const Eigen::Vector3d x =
               to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
-          const ToolContactPoint c = tool_contact(*m.tool, load.tool_position, x);
+          const ToolContactPoint c = tool_contact(*m.tool, load.tool_position, x, m.crack_side(cell, f));
           if (c.inside)
             pressure[cell->active_cell_index()] =
                 std::max(pressure[cell->active_cell_index()], static_cast<float>(m.penalty * c.penetration));
         }
       }
   }
-  for (const auto& cell : m.tria.active_cell_iterators())
+  for (const auto& cell : m.dof.active_cell_iterators())
     material[cell->active_cell_index()] = static_cast<float>(cell->material_id());
   StressPostprocessor stress(m.laws);
   dealii::DataOut<3> out;
@@ -777,15 +1373,37 @@ void FiniteStrainSolver::write_fields(const std::filesystem::path& vtu, const Lo
   const std::vector<std::string> names(3, "displacement");
   const std::vector<dealii::DataComponentInterpretation::DataComponentInterpretation> kinds(
       3, dealii::DataComponentInterpretation::component_is_part_of_vector);
-  out.add_data_vector(m.u, names, dealii::DataOut<3>::type_dof_data, kinds);
-  out.add_data_vector(m.u, stress);
+  out.add_data_vector(u, names, dealii::DataOut<3>::type_dof_data, kinds);
+  out.add_data_vector(u, stress);
   out.add_data_vector(pressure, "contact_pressure", dealii::DataOut<3>::type_cell_data);
   out.add_data_vector(material, "material_id", dealii::DataOut<3>::type_cell_data);
   // Quadratic output cells without write_higher_order_cells (dealii-on-debian12.md, "output").
+  // (Distributed: DataOut takes this process's locally owned cells.)
   out.build_patches(*m.mapping, static_cast<unsigned>(m.settings.degree));
-  std::ofstream file(vtu);
-  if (!file) throw std::runtime_error("write_fields: cannot open " + vtu.string());
-  out.write_vtu(file);
+  if (!m.distributed) {
+    std::ofstream stream(file);
+    if (!stream) throw std::runtime_error("write_fields: cannot open " + file.string());
+    out.write_vtu(stream);
+    return;
+  }
+  // One .vtu piece per process beside the .pvtu record that lists them (written by rank 0 after
+  // every piece is in place), each atomically.
+  auto piece = [&](int rank) { return file.stem().string() + "." + std::to_string(rank) + ".vtu"; };
+  auto write = [](const std::filesystem::path& target, const std::function<void(std::ostream&)>& body) {
+    write_atomically(target, [&](const std::filesystem::path& tmp) {
+      std::ofstream stream(tmp);
+      if (!stream) throw std::runtime_error("write_fields: cannot open " + tmp.string());
+      body(stream);
+      stream.flush();
+      if (!stream) throw std::runtime_error("write_fields: writing " + tmp.string() + " failed");
+    });
+  };
+  write(file.parent_path() / piece(rank), [&](std::ostream& stream) { out.write_vtu(stream); });
+  MPI_Barrier(parallel->comm);
+  if (rank != 0) return;
+  std::vector<std::string> pieces;
+  for (int r = 0; r < process_count; ++r) pieces.push_back(piece(r));
+  write(file, [&](std::ostream& stream) { out.write_pvtu_record(stream, pieces); });
 }
 
 } // namespace kerf::reference

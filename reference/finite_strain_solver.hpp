@@ -5,11 +5,18 @@
 // tractions and a rigid tool in penalty contact. In the spirit of deal.II's step-44 and the code
 // gallery's "Quasi-Static Finite-Strain Compressible Elasticity", written for tetrahedra.
 //
+// Under `mpirun -np N` (N > 1) the solver is distributed: the mesh is split over the N processes
+// (parallel::fullydistributed::Triangulation), PETSc MPI vectors and matrix, MUMPS or CG + GAMG;
+// every member function is then collective (all processes call it, in the same order) and
+// returns the same global values on every process unless its comment says otherwise. Started
+// on its own, the program solves serially (deal.II vectors, UMFPACK) without initialising MPI.
+//
 // This header is plain data + pimpl: it includes no deal.II or PETSc, so the rest of kerf compiles
-// without them (the only translation units that include deal.II are finite_strain_solver.cpp,
-// tangent_solver.cpp and field_output.cpp in this folder).
+// without them (the only translation units that include deal.II are finite_strain_solver.cpp and
+// tangent_solver.cpp in this folder; mpi_processes.cpp includes PETSc).
 
 #include "meshes/tet_mesh.hpp"
+#include "reference/cohesive/cohesive_law.hpp"
 #include "reference/rigid_tool.hpp"
 
 #include <Eigen/Core>
@@ -62,6 +69,20 @@ struct TractionBoundary {
   Eigen::Vector3d total_force = Eigen::Vector3d::Zero(); ///< [N] at load factor 1
 };
 
+/// A cohesive interface along a crack path (Reference II): the mesh has been split along the crack
+/// (meshes/crack_split.hpp) so that its two sides are the surface groups `plus_surface` and
+/// `minus_surface`. The solver pairs their coincident faces by position (also after global
+/// refinement) and joins them with the bilinear law of reference/cohesive/cohesive_law.hpp,
+/// integrated at the face quadrature points of the + side: the interface element of Ortiz &
+/// Pandolfi 1999 (§2), with the opening Δ = x⁺ − x⁻ interpolated by each side's own shape functions.
+/// The normal is the reference one (n from − into +): the interface is geometrically linear, which
+/// holds while the crack faces rotate little (the blade and tearing scenes; say so where it matters).
+struct CohesiveInterfaceSpec {
+  std::string plus_surface;  ///< e.g. "cut_plane+"
+  std::string minus_surface; ///< e.g. "cut_plane-"
+  CohesiveLawParameters law;
+};
+
 /// The boundary-value problem: mesh (metres), materials, supports, loads, tool.
 struct FiniteStrainProblem {
   TetMesh mesh;
@@ -69,12 +90,13 @@ struct FiniteStrainProblem {
   std::vector<DisplacementBoundary> displacement_boundaries;
   std::vector<TractionBoundary> tractions;
   std::optional<RigidToolShape> tool;    ///< rigid tool in frictionless penalty contact
+  std::optional<CohesiveInterfaceSpec> cohesive; ///< crack path held by a cohesive law
 };
 
 /// Linear solver for each Newton step.
 enum class LinearSolverChoice {
   automatic, ///< direct up to SolverSettings::direct_dof_limit DOFs, iterative above
-  direct,    ///< UMFPACK (deal.II SparseDirectUMFPACK) on an optimised BLAS
+  direct,    ///< UMFPACK (deal.II SparseDirectUMFPACK) on an optimised BLAS; distributed: MUMPS
   iterative  ///< PETSc CG + GAMG with the rigid-body near null space; unpreconditioned-norm stop
 };
 
@@ -96,12 +118,27 @@ struct SolverSettings {
   double edge_line_penalty = 0.0;
   /// Blade edge pass: edge point spacing [m]; 0 = automatic, h_min / 4.
   double edge_point_spacing = 0.0;
+  /// Launched by mpirun with N > 1 processes: distribute the mesh over them (true), or solve the
+  /// whole problem on this process alone (false, e.g. a serial comparison inside an MPI job).
+  bool distribute = true;
 };
 
 /// The load of one equilibrium solve.
 struct LoadState {
   double load_factor = 0.0;                               ///< scales tractions and prescribed u
   Eigen::Vector3d tool_position = Eigen::Vector3d::Zero(); ///< tool reference point [m]
+  double time = 0.0; ///< [s] trajectory time; its increment drives the cohesive viscous term
+};
+
+/// The cohesive interface after a converged solve (all zero without one). Energies per the whole
+/// interface; areas in the reference configuration.
+struct CohesiveSummary {
+  double failed_area = 0.0;        ///< area whose points have failed (κ >= δ_f) [m^2]
+  double damaged_area = 0.0;       ///< area whose points are past the peak (κ > δ_0) [m^2]
+  double stored_energy = 0.0;      ///< recoverable interface energy ∫ φ_e dA [J]
+  double dissipated_energy = 0.0;  ///< cohesive dissipation ∫ φ_d(κ) dA, total so far [J]
+  double viscous_dissipation = 0.0; ///< ∫∫ η |Δ̇|² dA dt, total so far [J]
+  double max_damage = 0.0;         ///< largest 1 − K(κ)/K_0 over the points
 };
 
 /// The reaction at one displacement boundary: the force the body puts on that support.
@@ -125,6 +162,7 @@ struct EquilibriumReport {
   /// Global balance of the body: traction_resultant − tool_force − support_reaction [N]; zero at
   /// equilibrium up to the free-DOF residual (Newton's third law: the body is at rest).
   Eigen::Vector3d force_imbalance = Eigen::Vector3d::Zero();
+  CohesiveSummary cohesive; ///< the interface after this solve (converged solves only)
   int contact_points = 0;    ///< boundary quadrature points inside the tool
   double contact_area = 0.0; ///< reference area of those points' weights [m^2]
   double max_contact_pressure = 0.0; ///< [Pa]
@@ -157,27 +195,43 @@ public:
 
   [[nodiscard]] std::size_t dof_count() const;
   [[nodiscard]] std::size_t cell_count() const;
-  /// "umfpack" or "petsc-cg-gamg": what `solve` uses for this problem size and settings.
+  /// "umfpack", "mumps" (distributed direct) or "petsc-cg-gamg": what `solve` uses.
   [[nodiscard]] std::string linear_solver_name() const;
   /// The contact penalty in use [Pa/m].
   [[nodiscard]] double contact_penalty() const;
+  /// The number of MPI processes the mesh is distributed over (1: serial).
+  [[nodiscard]] int process_count() const;
+  /// Cohesive interface: its quadrature points (0 without one) and how far the failed part
+  /// reaches along `direction` (unit) beyond the interface's first point along it [m] — the crack
+  /// depth c of paper 001 Fig. 3 when `direction` is the cutting direction; 0 if nothing failed.
+  [[nodiscard]] std::size_t cohesive_point_count() const;
+  [[nodiscard]] double crack_extent(const Eigen::Vector3d& direction) const;
 
   /// Displacement [m] at reference point X (evaluated in the tetrahedron containing X). Throws
   /// std::out_of_range if X lies outside the mesh.
   [[nodiscard]] Eigen::Vector3d displacement_at(const Eigen::Vector3d& X) const;
-  /// Cauchy stress [Pa] at every cell quadrature point of the current state.
+  /// Cauchy stress [Pa] at every cell quadrature point of the current state (distributed: of this
+  /// process's locally owned cells only).
   [[nodiscard]] std::vector<Eigen::Matrix3d> quadrature_cauchy_stresses() const;
+  /// Stored elastic energy of the body ∫ ψ(F) dV over the reference volume [J] (for energy
+  /// balances: external work = strain energy + interface energy + dissipation).
+  [[nodiscard]] double strain_energy() const;
   /// Largest displacement magnitude over the DOFs [m].
   [[nodiscard]] double max_displacement() const;
 
-  /// The state for a checkpoint: the DOF values of the displacement.
+  /// The state for a checkpoint: the DOF values of the displacement, all of them in global DOF
+  /// order on every process (distributed: gathered; the numbering depends on the process count,
+  /// so a state is restored with the same number of processes), followed (with a cohesive
+  /// interface) by each interface point's history (κ, previous opening) and the last time.
   [[nodiscard]] std::vector<double> state() const;
   /// Restores a checkpointed state. Throws std::invalid_argument on a size mismatch.
   void set_state(const std::vector<double>& values);
 
-  /// Writes the current fields to `vtu` (displacement; J, Cauchy stress, von Mises per point;
-  /// contact pressure and material id per cell) with the tool at `load.tool_position`.
-  void write_fields(const std::filesystem::path& vtu, const LoadState& load) const;
+  /// Writes the current fields (displacement; J, Cauchy stress, von Mises per point; contact
+  /// pressure and material id per cell) with the tool at `load.tool_position` to `file`: a .vtu
+  /// when serial; distributed, `file` is a .pvtu record (written by rank 0) listing one .vtu piece
+  /// per process, `<stem>.<rank>.vtu` beside it, each file written atomically.
+  void write_fields(const std::filesystem::path& file, const LoadState& load) const;
 
   struct Impl;
 

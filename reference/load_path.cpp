@@ -10,6 +10,7 @@ LoadState interpolate(const LoadState& a, const LoadState& b, double f) {
   LoadState out;
   out.load_factor = a.load_factor + f * (b.load_factor - a.load_factor);
   out.tool_position = a.tool_position + f * (b.tool_position - a.tool_position);
+  out.time = a.time + f * (b.time - a.time);
   return out;
 }
 

@@ -29,7 +29,8 @@ void validate(const RigidToolShape& s) {
     throw std::invalid_argument("rigid tool: wedge edge_length must be positive, got " + std::to_string(s.edge_length));
 }
 
-ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c, const Eigen::Vector3d& x) {
+ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c, const Eigen::Vector3d& x,
+                              const Eigen::Vector3d& side) {
   ToolContactPoint out;
   const Eigen::Vector3d r = x - c;
   if (s.kind == RigidToolShape::Kind::sphere) {
@@ -53,16 +54,19 @@ ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c,
   // An edge_length of 0 (a shape that skipped validate) leaves the wedge unbounded along e.
   const double half_length = s.edge_length > 0.0 ? 0.5 * s.edge_length : std::numeric_limits<double>::infinity();
   const std::array<double, 6> offsets{0.0, 0.0, 0.5 * s.thickness, 0.5 * s.thickness, half_length, half_length};
+  // Inside iff every s_k < 0 (whatever the side); the exit is the allowed face with the largest s_k.
   int face = -1;
-  double largest = -std::numeric_limits<double>::infinity();
+  double largest = -std::numeric_limits<double>::infinity(), largest_any = largest;
   for (std::size_t k = 0; k < normals.size(); ++k) {
     const double sk = r.dot(normals[k]) - offsets[k];
+    largest_any = std::max(largest_any, sk);
+    if (normals[k].dot(side) < -1e-12) continue; // an exit into the other face's material
     if (sk > largest) {
       largest = sk;
       face = static_cast<int>(k);
     }
   }
-  if (largest >= 0.0) return out;
+  if (largest_any >= 0.0) return out;
   out.inside = true;
   out.penetration = -largest;
   out.normal = normals[static_cast<std::size_t>(face)];

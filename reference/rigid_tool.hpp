@@ -42,6 +42,13 @@ struct ToolContactPoint {
 ///   s₅ = (x−c)·e − L/2 <= 0,               s₆ = −(x−c)·e − L/2 <= 0 (the ends of the edge),
 /// infinite behind the edge; the penetration is −max sₖ and n the normal of the face attaining it
 /// (the nearest exit). The edge itself is pressed against the body by blade_edge_contact.hpp.
-ToolContactPoint tool_contact(const RigidToolShape& shape, const Eigen::Vector3d& position, const Eigen::Vector3d& x);
+///
+/// `side` (wedge only; zero = none): for a point on one face of a crack the blade runs in, the unit
+/// direction into that face's own material. Such a point leaves the wedge only through a face
+/// whose outward normal does not point against it (normal · side >= 0), so the two faces of the
+/// crack are pushed apart to their own sides even where the blade's two flanks are equally near
+/// (on the crack plane, at the edge), instead of one of them being pushed through the blade.
+ToolContactPoint tool_contact(const RigidToolShape& shape, const Eigen::Vector3d& position, const Eigen::Vector3d& x,
+                              const Eigen::Vector3d& side = Eigen::Vector3d::Zero());
 
 } // namespace kerf::reference

@@ -1,10 +1,11 @@
 #include "reference/tangent_solver.hpp"
 
+#include "reference/mpi_processes.hpp"
+
 #include <deal.II/lac/sparse_direct.h>
 
 #include <petscksp.h>
 
-#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -16,19 +17,46 @@ void check(PetscErrorCode code, const char* what) {
   if (code != 0) throw std::runtime_error(std::string("PETSc error ") + std::to_string(code) + " in " + what);
 }
 
-void finalize_petsc() {
-  PetscBool finalized = PETSC_FALSE;
-  PetscFinalized(&finalized);
-  if (!finalized) PetscFinalize();
+/// CG on the true residual, preconditioned by GAMG (the near null space is set on the matrix).
+void configure_cg_gamg(KSP ksp, double tolerance) {
+  check(KSPSetType(ksp, KSPCG), "KSPSetType");
+  check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
+  check(KSPSetTolerances(ksp, tolerance, 1e-300, PETSC_DEFAULT, 5000), "KSPSetTolerances");
+  PC pc = nullptr;
+  check(KSPGetPC(ksp, &pc), "KSPGetPC");
+  check(PCSetType(pc, PCGAMG), "PCSetType");
+  check(KSPSetFromOptions(ksp), "KSPSetFromOptions");
 }
 
-// PETSc (and through it MPI) is initialised on first use; kerf's programs have no MPI main.
-void ensure_petsc() {
-  PetscBool initialized = PETSC_FALSE;
-  PetscInitialized(&initialized);
-  if (initialized) return;
-  check(PetscInitializeNoArguments(), "PetscInitializeNoArguments");
-  std::atexit(finalize_petsc);
+/// Gives `A` elasticity's six rigid-body modes as near null space, built from the support points
+/// of its locally owned rows (block size 3, node-major).
+void set_rigid_body_modes(Mat A, MPI_Comm comm, const std::vector<dealii::Point<3>>& coordinates) {
+  const auto n = static_cast<PetscInt>(coordinates.size());
+  Vec coords = nullptr;
+  check(VecCreateMPI(comm, n, PETSC_DETERMINE, &coords), "VecCreateMPI");
+  check(VecSetBlockSize(coords, 3), "VecSetBlockSize");
+  PetscScalar* c = nullptr;
+  check(VecGetArray(coords, &c), "VecGetArray");
+  for (PetscInt i = 0; i < n; ++i) c[i] = coordinates[static_cast<std::size_t>(i)][static_cast<unsigned>(i % 3)];
+  check(VecRestoreArray(coords, &c), "VecRestoreArray");
+  MatNullSpace nullspace = nullptr;
+  check(MatNullSpaceCreateRigidBody(coords, &nullspace), "MatNullSpaceCreateRigidBody");
+  check(MatSetNearNullSpace(A, nullspace), "MatSetNearNullSpace");
+  MatNullSpaceDestroy(&nullspace);
+  VecDestroy(&coords);
+}
+
+/// Runs the KSP; throws naming the solver if it did not converge. Returns the iteration count.
+int run_ksp(KSP ksp, Vec b, Vec x, const std::string& name) {
+  check(KSPSolve(ksp, b, x), "KSPSolve");
+  KSPConvergedReason reason;
+  check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
+  PetscInt iterations = 0;
+  check(KSPGetIterationNumber(ksp, &iterations), "KSPGetIterationNumber");
+  if (reason < 0)
+    throw std::runtime_error(name + " did not converge (reason " + std::to_string(static_cast<int>(reason)) +
+                             " after " + std::to_string(iterations) + " iterations)");
+  return static_cast<int>(iterations);
 }
 
 } // namespace
@@ -45,12 +73,15 @@ struct TangentSolver::Petsc {
   }
 };
 
-TangentSolver::TangentSolver(Kind kind, std::vector<dealii::Point<3>> coordinates, double tol)
-    : m_kind(kind), m_coordinates(std::move(coordinates)), m_tolerance(tol) {}
+TangentSolver::TangentSolver(Kind kind, std::vector<dealii::Point<3>> coordinates, double tol, bool distributed)
+    : m_kind(kind), m_coordinates(std::move(coordinates)), m_tolerance(tol), m_distributed(distributed) {}
 
 TangentSolver::~TangentSolver() = default;
 
-std::string TangentSolver::name() const { return m_kind == Kind::direct ? "umfpack" : "petsc-cg-gamg"; }
+std::string TangentSolver::name() const {
+  if (m_kind == Kind::iterative) return "petsc-cg-gamg";
+  return m_distributed ? "mumps" : "umfpack";
+}
 
 int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<double>& x,
                          const dealii::Vector<double>& b) {
@@ -60,7 +91,7 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
     umfpack.vmult(x, b);
     return 0;
   }
-  ensure_petsc();
+  initialize_petsc();
   const auto n = static_cast<PetscInt>(K.m());
   if (!m_petsc) {
     m_petsc = std::make_unique<Petsc>();
@@ -72,13 +103,7 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
     check(MatSetOption(m_petsc->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
     check(MatCreateVecs(m_petsc->A, &m_petsc->x, &m_petsc->b), "MatCreateVecs");
     check(KSPCreate(PETSC_COMM_SELF, &m_petsc->ksp), "KSPCreate");
-    check(KSPSetType(m_petsc->ksp, KSPCG), "KSPSetType");
-    check(KSPSetNormType(m_petsc->ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
-    check(KSPSetTolerances(m_petsc->ksp, m_tolerance, 1e-300, PETSC_DEFAULT, 5000), "KSPSetTolerances");
-    PC pc = nullptr;
-    check(KSPGetPC(m_petsc->ksp, &pc), "KSPGetPC");
-    check(PCSetType(pc, PCGAMG), "PCSetType");
-    check(KSPSetFromOptions(m_petsc->ksp), "KSPSetFromOptions");
+    configure_cg_gamg(m_petsc->ksp, m_tolerance);
   }
   // Copy the values row by row (PETSc sorts the columns).
   check(MatZeroEntries(m_petsc->A), "MatZeroEntries");
@@ -97,19 +122,7 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
   }
   check(MatAssemblyBegin(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   check(MatAssemblyEnd(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
-  // The six rigid-body modes from the DOF coordinates (block size 3, node-major).
-  Vec coords = nullptr;
-  check(VecCreateSeq(PETSC_COMM_SELF, n, &coords), "VecCreateSeq");
-  check(VecSetBlockSize(coords, 3), "VecSetBlockSize");
-  PetscScalar* c = nullptr;
-  check(VecGetArray(coords, &c), "VecGetArray");
-  for (PetscInt i = 0; i < n; ++i) c[i] = m_coordinates[static_cast<std::size_t>(i)][static_cast<unsigned>(i % 3)];
-  check(VecRestoreArray(coords, &c), "VecRestoreArray");
-  MatNullSpace nullspace = nullptr;
-  check(MatNullSpaceCreateRigidBody(coords, &nullspace), "MatNullSpaceCreateRigidBody");
-  check(MatSetNearNullSpace(m_petsc->A, nullspace), "MatSetNearNullSpace");
-  MatNullSpaceDestroy(&nullspace);
-  VecDestroy(&coords);
+  set_rigid_body_modes(m_petsc->A, PETSC_COMM_SELF, m_coordinates);
   check(KSPSetOperators(m_petsc->ksp, m_petsc->A, m_petsc->A), "KSPSetOperators");
 
   PetscScalar* pb = nullptr;
@@ -117,19 +130,78 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
   for (PetscInt i = 0; i < n; ++i) pb[i] = b[static_cast<std::size_t>(i)];
   check(VecRestoreArray(m_petsc->b, &pb), "VecRestoreArray");
   check(VecSet(m_petsc->x, 0.0), "VecSet");
-  check(KSPSolve(m_petsc->ksp, m_petsc->b, m_petsc->x), "KSPSolve");
-  KSPConvergedReason reason;
-  check(KSPGetConvergedReason(m_petsc->ksp, &reason), "KSPGetConvergedReason");
-  PetscInt iterations = 0;
-  check(KSPGetIterationNumber(m_petsc->ksp, &iterations), "KSPGetIterationNumber");
-  if (reason < 0)
-    throw std::runtime_error("PETSc CG + GAMG did not converge (reason " + std::to_string(static_cast<int>(reason)) +
-                             " after " + std::to_string(iterations) + " iterations)");
+  const int iterations = run_ksp(m_petsc->ksp, m_petsc->b, m_petsc->x, "PETSc CG + GAMG");
   const PetscScalar* px = nullptr;
   check(VecGetArrayRead(m_petsc->x, &px), "VecGetArrayRead");
   for (PetscInt i = 0; i < n; ++i) x[static_cast<std::size_t>(i)] = px[i];
   check(VecRestoreArrayRead(m_petsc->x, &px), "VecRestoreArrayRead");
-  return static_cast<int>(iterations);
+  return iterations;
+}
+
+int TangentSolver::solve(const dealii::PETScWrappers::MPI::SparseMatrix& K, dealii::PETScWrappers::MPI::Vector& x,
+                         const dealii::PETScWrappers::MPI::Vector& b) {
+  const MPI_Comm comm = K.get_mpi_communicator();
+  Mat A = static_cast<Mat>(K);
+  if (!m_petsc) {
+    m_petsc = std::make_unique<Petsc>();
+    check(KSPCreate(comm, &m_petsc->ksp), "KSPCreate");
+    if (m_kind == Kind::direct) {
+      // MUMPS: a parallel sparse LU (the tangent with contact need not be symmetric).
+      check(KSPSetType(m_petsc->ksp, KSPPREONLY), "KSPSetType");
+      PC pc = nullptr;
+      check(KSPGetPC(m_petsc->ksp, &pc), "KSPGetPC");
+      check(PCSetType(pc, PCLU), "PCSetType");
+      check(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
+      check(KSPSetFromOptions(m_petsc->ksp), "KSPSetFromOptions");
+    } else {
+      // GAMG needs block size 3 for the rigid-body modes, which deal.II's matrix was created
+      // without: a copy with block size 3 and the same rows (preallocated once, values every step).
+      PetscInt first = 0, last = 0;
+      check(MatGetOwnershipRange(A, &first, &last), "MatGetOwnershipRange");
+      std::vector<PetscInt> diagonal(static_cast<std::size_t>(last - first)), off(diagonal.size());
+      for (PetscInt r = first; r < last; ++r) {
+        PetscInt ncols = 0;
+        const PetscInt* cols = nullptr;
+        check(MatGetRow(A, r, &ncols, &cols, nullptr), "MatGetRow");
+        for (PetscInt k = 0; k < ncols; ++k)
+          ++(cols[k] >= first && cols[k] < last ? diagonal : off)[static_cast<std::size_t>(r - first)];
+        check(MatRestoreRow(A, r, &ncols, &cols, nullptr), "MatRestoreRow");
+      }
+      check(MatCreate(comm, &m_petsc->A), "MatCreate");
+      check(MatSetSizes(m_petsc->A, last - first, last - first, PETSC_DETERMINE, PETSC_DETERMINE), "MatSetSizes");
+      check(MatSetBlockSize(m_petsc->A, 3), "MatSetBlockSize");
+      check(MatSetType(m_petsc->A, MATAIJ), "MatSetType");
+      check(MatMPIAIJSetPreallocation(m_petsc->A, 0, diagonal.data(), 0, off.data()), "MatMPIAIJSetPreallocation");
+      check(MatSeqAIJSetPreallocation(m_petsc->A, 0, diagonal.data()), "MatSeqAIJSetPreallocation");
+      check(MatSetOption(m_petsc->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+      configure_cg_gamg(m_petsc->ksp, m_tolerance);
+    }
+  }
+  if (m_kind == Kind::iterative) {
+    PetscInt first = 0, last = 0;
+    check(MatGetOwnershipRange(A, &first, &last), "MatGetOwnershipRange");
+    check(MatZeroEntries(m_petsc->A), "MatZeroEntries");
+    for (PetscInt r = first; r < last; ++r) {
+      PetscInt ncols = 0;
+      const PetscInt* cols = nullptr;
+      const PetscScalar* vals = nullptr;
+      check(MatGetRow(A, r, &ncols, &cols, &vals), "MatGetRow");
+      check(MatSetValues(m_petsc->A, 1, &r, ncols, cols, vals, INSERT_VALUES), "MatSetValues");
+      check(MatRestoreRow(A, r, &ncols, &cols, &vals), "MatRestoreRow");
+    }
+    check(MatAssemblyBegin(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+    check(MatAssemblyEnd(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+    set_rigid_body_modes(m_petsc->A, comm, m_coordinates);
+    A = m_petsc->A;
+  }
+  check(KSPSetOperators(m_petsc->ksp, A, A), "KSPSetOperators");
+  Vec xv = static_cast<const Vec&>(x);
+  check(VecSet(xv, 0.0), "VecSet");
+  if (m_kind == Kind::direct) {
+    run_ksp(m_petsc->ksp, static_cast<const Vec&>(b), xv, "MUMPS");
+    return 0;
+  }
+  return run_ksp(m_petsc->ksp, static_cast<const Vec&>(b), xv, "PETSc CG + GAMG");
 }
 
 } // namespace kerf::reference

@@ -3,9 +3,13 @@
 // PETSc CG preconditioned by GAMG with elasticity's six rigid-body modes as near null space for
 // large ones (../shared/notes/dealii-on-debian12.md: without them AMG loses to Jacobi). The CG stop
 // test uses the unpreconditioned (true) residual, which Newton's convergence depends on.
+// Distributed over MPI processes (PETSc MPI matrix and vectors): MUMPS is the direct solver (a
+// parallel LU), CG + GAMG the iterative one, both on the matrix's communicator.
 // Internal to reference/: includes deal.II, never included outside this folder.
 
 #include <deal.II/base/point.h>
+#include <deal.II/lac/petsc_sparse_matrix.h>
+#include <deal.II/lac/petsc_vector.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
 
@@ -21,7 +25,10 @@ public:
   enum class Kind { direct, iterative };
   /// `coordinates`: the support point of each DOF, in node-major order (DOFs 3k, 3k+1, 3k+2 are
   /// the x, y, z components of one node), used for the rigid-body modes of the iterative solver.
-  TangentSolver(Kind kind, std::vector<dealii::Point<3>> coordinates, double relative_tolerance);
+  /// `distributed`: the systems are PETSc MPI ones (the second `solve`); `coordinates` are then
+  /// the support points of this process's locally owned DOFs, in their global order.
+  TangentSolver(Kind kind, std::vector<dealii::Point<3>> coordinates, double relative_tolerance,
+                bool distributed = false);
   ~TangentSolver();
   TangentSolver(const TangentSolver&) = delete;
   TangentSolver& operator=(const TangentSolver&) = delete;
@@ -29,7 +36,12 @@ public:
   /// Solves K x = b. Returns the number of iterations (0 for the direct solver). Throws
   /// std::runtime_error if the factorisation or the iteration fails.
   int solve(const dealii::SparseMatrix<double>& K, dealii::Vector<double>& x, const dealii::Vector<double>& b);
+  /// Solves K x = b distributed over K's communicator (collective): MUMPS for Kind::direct, CG +
+  /// GAMG for Kind::iterative. Same return value and errors as the serial overload.
+  int solve(const dealii::PETScWrappers::MPI::SparseMatrix& K, dealii::PETScWrappers::MPI::Vector& x,
+            const dealii::PETScWrappers::MPI::Vector& b);
   [[nodiscard]] Kind kind() const { return m_kind; }
+  /// "umfpack" / "mumps" (direct, serial / distributed) or "petsc-cg-gamg".
   [[nodiscard]] std::string name() const;
 
 private:
@@ -38,6 +50,7 @@ private:
   std::vector<dealii::Point<3>> m_coordinates;
   double m_tolerance;
   std::unique_ptr<Petsc> m_petsc;
+  bool m_distributed;
 };
 
 } // namespace kerf::reference

@@ -1,7 +1,10 @@
-// kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [--until T] [--levels L] [-o DIR]
-// [--resume] [--no-fields]: the finite-strain reference along the scene's trajectory (issue 3),
+// kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [--until T] [--levels L]
+// [--element-size H] [-o DIR] [--resume] [--no-fields] [--solver auto|direct|iterative] [--np N]
+// [--fracture auto|on|off]: the finite-strain reference along the scene's trajectory (issue 3),
 // written as profile.csv + manifest.json (+ fields.pvd), with a progress line per sample and
-// checkpoints to resume from; with --levels, a mesh convergence study over L refinements.
+// checkpoints to resume from; with --levels, a mesh convergence study over L refinements. `--np N`
+// re-launches the same command under `mpirun -np N` (as `mpirun -np N kerf reference …` does
+// directly): the solver runs distributed.
 
 #include "experiments/cli/commands.hpp"
 #include "experiments/run/reference_convergence.hpp"
@@ -12,10 +15,20 @@
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"
+#include "reference/mpi_processes.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
 #include <memory>
+#include <stdexcept>
+#include <thread>
+#include <vector>
 
 namespace kerf::cli {
 
@@ -31,12 +44,55 @@ struct ReferenceOptions {
   int levels = 0;      ///< 0: one run; >= 3: a convergence study over that many refinements
   std::string element_size; ///< overrides the scene's element size ("5 mm"); empty = the scene's
   bool resume = false;
+  std::string fracture = "off";
   bool no_fields = false;
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
+  reference::LinearSolverChoice solver = reference::LinearSolverChoice::automatic;
+  int np = 0; ///< MPI processes; 0 = this process alone (or as many as mpirun started)
 };
+
+/// Replaces this process by `mpirun -np N <this program> reference …` with the same options
+/// (--oversubscribe when N exceeds the cores; as root, Open MPI's OMPI_ALLOW_RUN_AS_ROOT[_CONFIRM]
+/// set, without which it refuses to start). Returns only by throwing.
+[[noreturn]] void relaunch_under_mpirun(const ReferenceOptions& o) {
+  const std::string program = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::vector<std::string> args{"mpirun", "-np", std::to_string(o.np)};
+  if (static_cast<unsigned>(o.np) > std::thread::hardware_concurrency()) args.emplace_back("--oversubscribe");
+  args.insert(args.end(), {program, "reference", o.scene, "--degree", std::to_string(o.degree), "--refine",
+                           std::to_string(o.refine)});
+  if (o.samples > 0) args.insert(args.end(), {"--samples", std::to_string(o.samples)});
+  if (o.until >= 0.0) args.insert(args.end(), {"--until", std::to_string(o.until)});
+  if (o.levels > 0) args.insert(args.end(), {"--levels", std::to_string(o.levels)});
+  if (!o.element_size.empty()) args.insert(args.end(), {"--element-size", o.element_size});
+  args.insert(args.end(), {"--fracture", o.fracture});
+  if (!o.out.empty()) args.insert(args.end(), {"-o", o.out});
+  if (o.resume) args.emplace_back("--resume");
+  if (o.no_fields) args.emplace_back("--no-fields");
+  if (!o.trajectory.empty()) args.insert(args.end(), {"--trajectory", o.trajectory});
+  const char* solver = o.solver == reference::LinearSolverChoice::direct      ? "direct"
+                       : o.solver == reference::LinearSolverChoice::iterative ? "iterative"
+                                                                               : "auto";
+  args.insert(args.end(), {"--solver", solver});
+  if (::geteuid() == 0) {
+    ::setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+    ::setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+  }
+  std::vector<char*> argv;
+  for (std::string& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  ::execvp("mpirun", argv.data());
+  throw std::runtime_error(std::string("--np ") + std::to_string(o.np) + ": cannot run mpirun: " + std::strerror(errno));
+}
 
 void run_reference_command(const ReferenceOptions& o) {
   namespace fs = std::filesystem;
+  const int launched = reference::mpirun_process_count();
+  if (o.np > 1 && launched == 0) relaunch_under_mpirun(o);
+  if (o.np > 0 && launched > 0 && o.np != launched)
+    throw std::invalid_argument("--np " + std::to_string(o.np) + " but mpirun started " + std::to_string(launched) +
+                                " processes");
   const Scene read = read_scene(resolve_scene(o.scene));
   const fs::path out = o.out.empty() ? fs::path("runs") / read.name / "reference" : fs::path(o.out);
   // A recorded session replays what the hand did at the rig through the ground truth.
@@ -47,6 +103,8 @@ void run_reference_command(const ReferenceOptions& o) {
   settings.refinements = o.refine;
   settings.write_fields = !o.no_fields;
   settings.resume = o.resume;
+  settings.linear_solver = o.solver;
+  settings.fracture = o.fracture == "on" ? ReferenceFracture::on : o.fracture == "off" ? ReferenceFracture::off : ReferenceFracture::automatic;
   if (o.samples < 0) throw std::invalid_argument("--samples must be >= 1, got " + std::to_string(o.samples));
   if (o.samples > 0 || o.until >= 0.0) {
     if (scene.tools.empty()) throw std::invalid_argument("scene '" + scene.name + "' has no tool");
@@ -70,12 +128,14 @@ void run_reference_command(const ReferenceOptions& o) {
     if (o.resume) throw std::invalid_argument("--resume does not apply to a convergence study (--levels)");
     const fs::path dir = o.out.empty() ? fs::path("runs") / read.name / "reference_convergence" : fs::path(o.out);
     const ConvergenceStudy study = run_reference_convergence(scene, mesh, settings, o.levels, dir);
+    if (reference::mpi_processes().rank != 0) return; // rank 0 reports
     std::printf("%s", convergence_markdown(scene, study).c_str());
     std::printf("wrote %s, %s\n", (dir / "convergence.csv").c_str(), (dir / "convergence.md").c_str());
     return;
   }
   const ForceProfile profile = run_reference(scene, mesh, settings, out);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  if (reference::mpi_processes().rank != 0) return; // rank 0 reports
   double peak = 0.0;
   for (const ProfileRow& r : profile.rows) peak = std::max(peak, r.force.norm());
   std::printf("%s / reference (P%d, %d refinements): %zu samples solved, peak |F| %.6g N, wall %.2f s\n",
@@ -106,6 +166,20 @@ void add_reference_command(CLI::App& app) {
   cmd->add_option("-o,--output", options->out, "output directory (default runs/SCENE/reference)");
   cmd->add_flag("--resume", options->resume, "continue from DIR/checkpoint.bin");
   cmd->add_flag("--no-fields", options->no_fields, "do not write fields.pvd and the .vtu files");
+  const std::map<std::string, reference::LinearSolverChoice> solvers{
+      {"auto", reference::LinearSolverChoice::automatic},
+      {"direct", reference::LinearSolverChoice::direct},
+      {"iterative", reference::LinearSolverChoice::iterative}};
+  cmd->add_option("--solver", options->solver,
+                  "linear solver: auto (direct up to 60000 DOFs), direct (UMFPACK; MUMPS under MPI) or iterative "
+                  "(PETSc CG + GAMG)")
+      ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case));
+  cmd->add_option("--np", options->np,
+                  "run distributed on N MPI processes: re-launches this command under mpirun -np N")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--fracture", options->fracture,
+                  "cohesive fracture along the scene's cut_plane: off (default until Reference II is complete), auto (cutting/tearing scenes with σ_c and J_c), on")
+      ->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_option("--trajectory", options->trajectory,
                   "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   cmd->callback([options] { run_reference_command(*options); });

@@ -71,7 +71,7 @@ void run_run(const RunOptions& o) {
   const ForceProfile profile = run_model(
       *built.model, names, o.trajectory.empty() ? sample_scene_trajectories(scene) : session_trajectories(o.trajectory, names));
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-  write_run(out, profile, run_manifest(scene, built, mesh, profile, wall));
+  write_run(out, profile, run_manifest(scene, built, mesh, profile, wall), &built);
 
   std::string sequence;
   for (std::size_t k = 0; k < profile.rows.size(); ++k)

@@ -1,13 +1,19 @@
-// kerf stability SCENE --model M [-o DIR]: the model pushed one axis at a time past its nominal
-// scene (issue 7, "Stability at the extremes"), every run classified, written as a table.
+// kerf stability SCENE --model M [-o DIR] [--doc FILE]: the model pushed one axis at a time past its
+// nominal scene (issue 7, "Stability at the extremes"), every run classified, written as a table
+// and a map (PNG, PDF); with --doc, the model's edge is written into that Markdown page.
 
 #include "experiments/cli/commands.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/stability_sweep.hpp"
+#include "experiments/study/study_plots.hpp"
 #include "experiments/study/study_table.hpp"
 
+#include "meshes/atomic_file.hpp"
+
 #include <cstdio>
+#include <fstream>
 #include <memory>
+#include <sstream>
 
 namespace kerf::cli {
 
@@ -17,7 +23,37 @@ struct StabilityOptions {
   std::string scene;
   std::string model;
   std::string out;
+  std::string doc;
 };
+
+/// Replaces (or appends before the end marker) this scene and model's block in the page's
+/// generated section, between "<!-- stability edges: begin -->" and "<!-- stability edges: end -->".
+void write_edges_into(const std::filesystem::path& doc, const std::string& scene, const std::string& model,
+                      const std::string& block) {
+  std::ifstream in(doc);
+  if (!in) throw std::runtime_error(doc.string() + ": cannot read the page to write the stability edges into");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string page = text.str();
+  const std::string end_marker = "<!-- stability edges: end -->";
+  const std::string open = "<!-- stability " + scene + " " + model + " -->\n", close = "<!-- /stability " + scene + " " + model + " -->\n";
+  const std::size_t end = page.find(end_marker);
+  if (end == std::string::npos || page.find("<!-- stability edges: begin -->") == std::string::npos)
+    throw std::runtime_error(doc.string() + ": no \"<!-- stability edges: begin -->\" … \"" + end_marker + "\" section");
+  const std::size_t from = page.find(open);
+  if (from != std::string::npos) {
+    const std::size_t to = page.find(close, from);
+    if (to == std::string::npos) throw std::runtime_error(doc.string() + ": unclosed block " + open);
+    page.replace(from, to + close.size() - from, open + block + close);
+  } else {
+    page.insert(end, open + block + close + "\n");
+  }
+  write_atomically(doc, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp);
+    f << page;
+    if (!f.flush()) throw std::runtime_error(doc.string() + ": write failed");
+  });
+}
 
 void run_stability(const StabilityOptions& o) {
   namespace fs = std::filesystem;
@@ -38,9 +74,17 @@ void run_stability(const StabilityOptions& o) {
                    p.outcome == StabilityClass::refused ? std::optional<double>() : std::optional<double>(p.reversal_fraction),
                    p.note});
   table.write(out, "stability");
-  std::printf("%s / %s: stability sweep, %zu runs\n%s", scene.name.c_str(), o.model.c_str(), points.size(),
-              table.markdown().c_str());
-  std::printf("wrote %s.{md,tex,csv}\n", (out / "stability").c_str());
+  plot_stability(out / "stability_map", {{o.model, out / "stability.csv"}});
+  const std::string edges = stability_edges(points);
+  std::printf("%s / %s: stability sweep, %zu runs\n%s\nedges:\n%s", scene.name.c_str(), o.model.c_str(), points.size(),
+              table.markdown().c_str(), edges.c_str());
+  std::printf("wrote %s.{md,tex,csv} and %s.{png,pdf}\n", (out / "stability").c_str(), (out / "stability_map").c_str());
+  if (!o.doc.empty()) {
+    write_edges_into(o.doc, scene.name, o.model,
+                     "**" + o.model + "** on `" + scene.name + "` (`kerf stability " + scene.name + " --model " + o.model +
+                         " --doc " + o.doc + "`, " + std::to_string(points.size()) + " runs):\n\n" + edges);
+    std::printf("wrote the edges into %s\n", o.doc.c_str());
+  }
 }
 
 } // namespace
@@ -52,6 +96,7 @@ void add_stability_command(CLI::App& app) {
   cmd->add_option("scene", options->scene, "scene file or name")->required();
   cmd->add_option("--model", options->model, "model name (see `kerf models`)")->required();
   cmd->add_option("-o,--output", options->out, "output directory (default runs/SCENE/MODEL/stability)");
+  cmd->add_option("--doc", options->doc, "write the model's edge into this Markdown page's generated section (docs/studies.md)");
   cmd->callback([options] { run_stability(*options); });
 }
 

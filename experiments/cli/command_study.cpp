@@ -1,9 +1,11 @@
-// kerf study STUDY [-o DIR] [--results-doc FILE]: scenes x models x resolutions, scored against the
-// reference, as tables (Markdown, LaTeX, CSV) and plots (issue 7).
+// kerf study STUDY [-o DIR] [--results-doc FILE] [--jobs N]: scenes x models x resolutions, scored
+// against the reference, as tables (Markdown, LaTeX, CSV) and plots (issue 7). Independent runs go
+// on N threads; under `mpirun -np R` they are spread over the R ranks too, and rank 0 writes.
 
 #include "experiments/cli/commands.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_plots.hpp"
+#include "experiments/study/study_ranks.hpp"
 #include "experiments/study/study_runner.hpp"
 
 #include "meshes/atomic_file.hpp"
@@ -12,6 +14,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <thread>
 
 namespace kerf::cli {
 
@@ -21,6 +24,7 @@ struct StudyOptions {
   std::string study;
   std::string out;
   std::string results_doc;
+  int jobs = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 };
 
 std::filesystem::path resolve_study(const std::string& argument) {
@@ -35,7 +39,9 @@ void run_study_command(const StudyOptions& o) {
   namespace fs = std::filesystem;
   const StudySpec spec = read_study(resolve_study(o.study));
   const fs::path out = o.out.empty() ? fs::path("runs") / "studies" / spec.name : fs::path(o.out);
-  const StudyResult result = run_study(spec, out, finite_element_reference());
+  const StudyRanks ranks;
+  const StudyResult result = run_study(spec, out, finite_element_reference(), ranks.execution(o.jobs));
+  if (ranks.rank() != 0) return; // rank 0 writes the tables, plots and documents
   const StudyTable table = result.table();
   table.write(out, "study");
 
@@ -66,8 +72,8 @@ void run_study_command(const StudyOptions& o) {
   for (const StudyRow& r : result.rows) any_error = any_error || r.metrics.has_value();
   if (any_error) plot_pareto(out / "pareto", out / "study.csv", "RMS force error [%]", "p99 cost [µs]", "model");
 
-  std::printf("study %s: %zu rows, %d reference solve(s) run (the rest from the cache)\n%s", spec.name.c_str(),
-              result.rows.size(), result.reference_runs, table.markdown().c_str());
+  std::printf("study %s: %zu rows, %d reference solve(s) run (the rest from the cache), %d job(s) x %d rank(s)\n%s",
+              spec.name.c_str(), result.rows.size(), result.reference_runs, o.jobs, ranks.size(), table.markdown().c_str());
   std::printf("wrote %s.{md,tex,csv} and plots in %s\n", (out / "study").c_str(), out.c_str());
 
   if (!o.results_doc.empty()) {
@@ -95,6 +101,8 @@ void add_study_command(CLI::App& app) {
   cmd->add_option("study", options->study, "study file or name (experiments/studies/NAME.toml)")->required();
   cmd->add_option("-o,--output", options->out, "output directory (default runs/studies/NAME)");
   cmd->add_option("--results-doc", options->results_doc, "also write the table as this Markdown page (docs/results.md)");
+  cmd->add_option("-j,--jobs", options->jobs, "independent runs at once on this machine (default: the hardware concurrency; "
+                                              "1 for undisturbed cost columns)")->check(CLI::Range(1, 1024));
   cmd->callback([options] { run_study_command(*options); });
 }
 

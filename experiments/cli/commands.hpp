@@ -19,7 +19,9 @@ void add_models_command(CLI::App& app); ///< kerf models
 void add_haptic_command(CLI::App& app);     ///< kerf haptic SCENE --model M --device ADDRESS... (the live rig)
 void add_device_sim_command(CLI::App& app); ///< kerf device-sim SCENE [--port P]... (emulated devices)
 void add_stability_command(CLI::App& app); ///< kerf stability SCENE --model M [-o DIR]
-void add_study_command(CLI::App& app);     ///< kerf study STUDY [-o DIR] [--results-doc FILE]
+void add_study_command(CLI::App& app);     ///< kerf study STUDY [-o DIR] [--results-doc FILE] [--jobs N] (mpirun-able)
+void add_calibrate_command(CLI::App& app); ///< kerf calibrate SCENE --model M [--trajectory S] [--target P] [-o FILE]
+void add_recommend_command(CLI::App& app); ///< kerf recommend SCENE --max-error 10% --rate 1000 [--tables DIR]
 void add_reference_command(CLI::App& app); ///< kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [-o DIR] [--resume] [--no-fields]
 
 } // namespace kerf::cli

@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   kerf::cli::add_device_sim_command(app);
   kerf::cli::add_stability_command(app);
   kerf::cli::add_study_command(app);
+  kerf::cli::add_calibrate_command(app);
+  kerf::cli::add_recommend_command(app);
   kerf::cli::add_reference_command(app);
   try {
     app.parse(argc, argv);

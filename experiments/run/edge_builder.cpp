@@ -1,8 +1,10 @@
 // The discrete-edge model (paper 000 §3.1, §3.3) built from a scene: one blade, its parameters
 // derived from the material (no extra scene section), per-layer materials, friction only if the
-// scene declares it.
+// scene declares it; the geometric cut of §3.2 runs off the stepping thread on the scene's mesh,
+// and a run writes the cut mesh (cut_mesh.vtu) and its fragments into the manifest.
 
 #include "experiments/run/model_builders.hpp"
+#include "meshes/vtu_writer.hpp"
 #include "realtime/edge/discrete_edge_cutting_model.hpp"
 
 #include <algorithm>
@@ -31,44 +33,47 @@ EdgeMaterial edge_material(const Material& m) {
 } // namespace
 
 void require_edge_inputs(const Scene& scene) {
-  if (scene.tools.size() != 1 || scene.tools.front().kind != Tool::Kind::blade)
-    throw ModelMismatch("model edge needs exactly one blade tool; scene " + scene.name + " has " +
-                        std::to_string(scene.tools.size()) + " tool(s)" +
-                        (scene.tools.empty() || scene.tools.front().kind == Tool::Kind::blade ? "" : ", not a blade"));
+  const bool one_blade = scene.tools.size() == 1 && scene.tools[0].kind == Tool::Kind::blade;
+  const bool blade_then_stylus = scene.tools.size() == 2 && scene.tools[0].kind == Tool::Kind::blade &&
+                                 scene.tools[1].kind == Tool::Kind::sphere;
+  if (!one_blade && !blade_then_stylus)
+    throw ModelMismatch("model edge needs one blade tool, or a blade and then a sphere stylus (paper 000 §4: cut, then "
+                        "pull a piece); scene " + scene.name + " has " + std::to_string(scene.tools.size()) +
+                        " tool(s) in another arrangement");
   if (!scene.phenomena.contains(Phenomenon::cutting))
     throw ModelMismatch("model edge renders cutting with a blade; scene " + scene.name + " declares no cutting");
 }
 
-BuiltModel build_edge_model(const Scene& scene, const TetMesh& mesh) {
-  const BladeShape& blade = scene.tools.front().blade;
+EdgeSceneSetup edge_setup_for_scene(const Scene& scene, const Tool& tool) {
+  const BladeShape& blade = tool.blade;
   // Resolution (numerical choices, not material): voxels of a quarter element, one discrete edge
   // point per voxel width along the edge (paper 000 gives neither).
-  const double voxel_size = scene.geometry.element_size / 4.0;
-  DiscreteEdgeSetup setup;
+  EdgeSceneSetup e;
+  e.voxel_size = scene.geometry.element_size / 4.0;
+  DiscreteEdgeSetup& setup = e.setup;
   setup.edge_direction = blade.edge_direction;
   setup.cutting_direction = blade.cutting_direction;
   setup.edge_length = blade.edge_length;
-  setup.point_count = std::max(1, static_cast<int>(std::ceil(blade.edge_length / voxel_size)));
+  setup.point_count = std::max(1, static_cast<int>(std::ceil(blade.edge_length / e.voxel_size)));
   setup.friction_coefficient = scene.phenomena.contains(Phenomenon::friction) ? scene.material.friction_coefficient : 0.0;
-  setup.channel_capture_width = std::max(blade.thickness, voxel_size);
+  setup.channel_capture_width = std::max(blade.thickness, e.voxel_size);
 
-  std::vector<std::string> regions;
   if (scene.phenomena.contains(Phenomenon::layers)) {
     for (const Material& layer : scene.layers) {
-      regions.push_back(layer.region);
+      e.regions.push_back(layer.region);
       setup.materials.push_back(edge_material(layer));
     }
   } else {
     setup.materials.push_back(edge_material(scene.material));
   }
 
-  nlohmann::json p;
+  nlohmann::json& p = e.parameters;
   p["edge_direction"] = vector_json(setup.edge_direction);
   p["cutting_direction"] = vector_json(setup.cutting_direction);
   p["edge_length_m"] = setup.edge_length;
   p["point_count"] = setup.point_count;
-  p["voxel_size_m"] = voxel_size;
-  p["regions"] = regions;
+  p["voxel_size_m"] = e.voxel_size;
+  p["regions"] = e.regions;
   nlohmann::json materials = nlohmann::json::array();
   for (const EdgeMaterial& m : setup.materials)
     materials.push_back({{"stiffness_per_length_Pa", m.stiffness_per_length},
@@ -77,9 +82,49 @@ BuiltModel build_edge_model(const Scene& scene, const TetMesh& mesh) {
   p["materials"] = materials;
   p["friction_coefficient"] = setup.friction_coefficient;
   p["channel_capture_width_m"] = setup.channel_capture_width;
-  CollisionVoxels voxels(mesh, voxel_size, regions);
-  p["marked_voxels"] = voxels.marked_count();
-  return {std::make_unique<DiscreteEdgeCuttingModel>(std::move(voxels), std::move(setup)), std::move(p)};
+  // The cut's trajectory is recorded every voxel width (the resolution of the collision model).
+  e.record_spacing = e.voxel_size;
+  p["geometric_cut"] = {{"record_spacing_m", e.record_spacing},
+                        {"snap_tolerance", e.cut.snap_tolerance},
+                        {"reach", e.cut.reach}};
+  return e;
+}
+
+BuiltModel build_edge_model(const Scene& scene, const TetMesh& mesh) {
+  if (scene.tools.size() == 2) return build_shape_forming_model(scene, mesh); // blade, then stylus
+  EdgeSceneSetup e = edge_setup_for_scene(scene, scene.tools.front());
+  CollisionVoxels voxels(mesh, e.voxel_size, e.regions);
+  e.parameters["marked_voxels"] = voxels.marked_count();
+  const RecordedEdge edge{e.setup.edge_direction, e.setup.edge_length};
+  auto model = std::make_unique<DiscreteEdgeCuttingModel>(std::move(voxels), std::move(e.setup));
+  model->attach_geometric_cut(std::make_unique<BackgroundCut>(mesh, edge, e.cut), e.record_spacing);
+  BuiltModel built{std::move(model), std::move(e.parameters)};
+  built.write_outputs = [edge_model = static_cast<DiscreteEdgeCuttingModel*>(built.model.get())](const std::filesystem::path& dir) {
+    return write_geometric_cut(*edge_model, dir);
+  };
+  return built;
+}
+
+nlohmann::json write_geometric_cut(DiscreteEdgeCuttingModel& model, const std::filesystem::path& dir) {
+  model.finish_geometric_cut();
+  const BackgroundCut& cut = *model.geometric_cut();
+  const CuttableBody& body = cut.body();
+  Eigen::MatrixXd fragment(body.mesh().tets.rows(), 1);
+  for (Eigen::Index t = 0; t < fragment.rows(); ++t) fragment(t, 0) = body.fragment_of_tet()[static_cast<std::size_t>(t)];
+  write_vtu(body.mesh(), dir / "cut_mesh.vtu", {}, {{"fragment", fragment}});
+  int cut_tets = 0;
+  for (const GeometricCutReport& r : cut.reports()) cut_tets += r.cut_tets;
+  nlohmann::json j;
+  j["mesh"] = "cut_mesh.vtu";
+  j["passes"] = cut.cuts_done();
+  j["cut_tetrahedra"] = cut_tets;
+  j["tetrahedra"] = body.mesh().tets.rows();
+  j["nodes"] = body.mesh().nodes.rows();
+  j["fragments"] = body.fragment_count();
+  j["fragment_volumes_m3"] = body.fragment_volumes();
+  j["dropped_positions"] = cut.dropped();
+  if (!cut.error().empty()) j["error"] = cut.error();
+  return {{"geometric_cut", j}};
 }
 
 } // namespace kerf

@@ -7,6 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <span>
@@ -39,6 +41,9 @@ public:
 struct BuiltModel {
   std::unique_ptr<ToolModel> model;
   nlohmann::json parameters;
+  /// Optional: what the model writes into a run's directory after the last step (the edge
+  /// model's cut mesh); returns the entries it adds to the run's manifest. Not realtime.
+  std::function<nlohmann::json(const std::filesystem::path& dir)> write_outputs = {};
 };
 
 /// Checks, before any meshing, that model `name` exists and can represent `scene`: it covers

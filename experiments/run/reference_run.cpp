@@ -4,6 +4,7 @@
 #include "meshes/atomic_file.hpp"
 #include "meshes/surface_mesh.hpp"
 #include "reference/load_path.hpp"
+#include "reference/mpi_processes.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -150,14 +151,16 @@ namespace {
 
 // ---------------------------------------------------------------------------------- checkpoint
 // Binary, native byte order (a checkpoint is resumed on the machine that wrote it):
-// "KERFREF1", scene sha256, degree, refinements, sample indices, targets solved, the last
-// converged load, the solver state, the profile rows, the per-sample manifest records.
+// "KERFREF2", scene sha256, degree, refinements, process count, sample indices, targets solved,
+// the last converged load, the solver state (global DOF order, which depends on the process
+// count), the profile rows, the per-sample manifest records.
 
-constexpr char checkpoint_magic[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '1'};
+constexpr char checkpoint_magic[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '2'};
 
 struct Checkpoint {
   std::string scene_sha256;
   int degree = 0, refinements = 0;
+  int processes = 1; ///< MPI processes the mesh was distributed over
   std::vector<std::size_t> indices;
   std::size_t solved = 0;
   LoadState last;
@@ -227,6 +230,7 @@ void write_checkpoint(const Checkpoint& c, const std::filesystem::path& file) {
     w.str(c.scene_sha256);
     w.i32(c.degree);
     w.i32(c.refinements);
+    w.i32(c.processes);
     w.u64(c.indices.size());
     for (std::size_t i : c.indices) w.u64(i);
     w.u64(c.solved);
@@ -263,6 +267,7 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
   c.scene_sha256 = r.str();
   c.degree = r.pod<std::int32_t>();
   c.refinements = r.pod<std::int32_t>();
+  c.processes = r.pod<std::int32_t>();
   c.indices.resize(r.count(std::uint64_t{1} << 32));
   for (std::size_t& i : c.indices) i = r.u64();
   c.solved = r.u64();
@@ -291,14 +296,16 @@ Checkpoint read_checkpoint(const std::filesystem::path& file) {
 }
 
 // ---------------------------------------------------------------------------------- fields
-std::string step_name(std::size_t k) {
+/// fields/step_NNNN.vtu, or the .pvtu record of the pieces of a distributed run.
+std::string step_name(std::size_t k, bool pieces) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "step_%04zu.vtu", k);
+  std::snprintf(buf, sizeof buf, pieces ? "step_%04zu.pvtu" : "step_%04zu.vtu", k);
   return buf;
 }
 
-/// dir/fields.pvd: the ParaView collection of the .vtu of the first `count` solved samples.
-void write_pvd(const std::filesystem::path& dir, const std::vector<double>& times, std::size_t count) {
+/// dir/fields.pvd: the ParaView collection of the .vtu (serial) or .pvtu (distributed: `pieces`)
+/// of the first `count` solved samples.
+void write_pvd(const std::filesystem::path& dir, const std::vector<double>& times, std::size_t count, bool pieces) {
   write_atomically(dir / "fields.pvd", [&](const std::filesystem::path& tmp) {
     std::ofstream out(tmp);
     if (!out) throw std::runtime_error("reference: cannot write " + tmp.string());
@@ -306,7 +313,7 @@ void write_pvd(const std::filesystem::path& dir, const std::vector<double>& time
            "  <Collection>\n";
     out.precision(17);
     for (std::size_t k = 0; k < count; ++k)
-      out << "    <DataSet timestep=\"" << times[k] << "\" group=\"\" part=\"0\" file=\"fields/" << step_name(k)
+      out << "    <DataSet timestep=\"" << times[k] << "\" group=\"\" part=\"0\" file=\"fields/" << step_name(k, pieces)
           << "\"/>\n";
     out << "  </Collection>\n</VTKFile>\n";
     out.flush();
@@ -326,7 +333,13 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   if (settings.checkpoint_every < 1)
     throw std::invalid_argument("reference: checkpoint_every must be >= 1, got " + std::to_string(settings.checkpoint_every));
 
-  const ReferenceProblem rp = reference_problem(scene, mesh);
+  ReferenceProblem rp = reference_problem(scene, mesh);
+  const CrackPathInfo crack = add_crack_path(scene, rp.problem, settings.fracture, settings.refinements);
+  if (!crack.warning.empty()) std::fprintf(stderr, "reference %s: warning: %s\n", scene.name.c_str(), crack.warning.c_str());
+  // The crack extent is measured along the blade's cutting direction (c of paper 001 Fig. 3), or
+  // downwards from the grasped top for a tear.
+  const Eigen::Vector3d crack_direction =
+      scene.tools.front().kind == Tool::Kind::blade ? scene.tools.front().blade.cutting_direction : Eigen::Vector3d(0, 0, -1);
   const std::size_t n = rp.positions.size();
   std::vector<std::size_t> indices = settings.sample_indices;
   if (indices.empty())
@@ -337,14 +350,19 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                   " (the trajectory's sample count); entry " + std::to_string(i) + " is " +
                                   std::to_string(indices[i]));
   const double T = rp.times.back();
-  auto load_of = [&](std::size_t k) { return LoadState{T > 0.0 ? rp.times[k] / T : 0.0, rp.positions[k]}; };
+  auto load_of = [&](std::size_t k) { return LoadState{T > 0.0 ? rp.times[k] / T : 0.0, rp.positions[k], rp.times[k]}; };
   const bool tied = rp.coupling.kind == ReferenceToolCoupling::Kind::tied;
   const std::string tool_name = scene.tools.front().name;
 
   reference::SolverSettings solver_settings;
   solver_settings.degree = settings.degree;
   solver_settings.refinements = settings.refinements;
+  solver_settings.linear_solver = settings.linear_solver;
+  solver_settings.distribute = settings.distribute;
   reference::FiniteStrainSolver solver(rp.problem, solver_settings);
+  // Under mpirun every process runs this function; rank 0 writes the files and the progress.
+  const bool writer = reference::mpi_processes().rank == 0;
+  const bool pieces = solver.process_count() > 1;
 
   const std::string sha = file_sha256(scene.file);
   const fs::path checkpoint_file = dir / "checkpoint.bin";
@@ -352,21 +370,27 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   cp.scene_sha256 = sha;
   cp.degree = settings.degree;
   cp.refinements = settings.refinements;
+  cp.processes = solver.process_count();
   cp.indices = indices;
   cp.last = load_of(0);
   std::optional<std::size_t> resumed_from;
   if (settings.resume && fs::exists(checkpoint_file)) {
     Checkpoint saved = read_checkpoint(checkpoint_file);
     if (saved.scene_sha256 != sha || saved.degree != settings.degree || saved.refinements != settings.refinements ||
-        saved.indices != indices)
+        saved.indices != indices || saved.processes != cp.processes)
       throw std::runtime_error("reference: " + checkpoint_file.string() +
-                               " is from a different run (scene file, degree, refinements or samples differ)");
+                               " is from a different run (scene file, degree, refinements, samples or MPI process "
+                               "count differ; it was written by " +
+                               std::to_string(saved.processes) + " process(es), this run has " +
+                               std::to_string(cp.processes) + ")");
     solver.set_state(saved.state);
     cp = std::move(saved);
+    cp.last.time = cp.last.load_factor * T; // the load factor is t/T (load_of), also between samples
     resumed_from = cp.solved;
-    std::fprintf(stderr, "reference %s: resuming after sample %zu/%zu from %s\n", scene.name.c_str(), cp.solved,
-                 indices.size(), checkpoint_file.c_str());
-  } else if (settings.resume) {
+    if (writer)
+      std::fprintf(stderr, "reference %s: resuming after sample %zu/%zu from %s\n", scene.name.c_str(), cp.solved,
+                   indices.size(), checkpoint_file.c_str());
+  } else if (settings.resume && writer) {
     std::fprintf(stderr, "reference %s: no checkpoint in %s, starting from the beginning\n", scene.name.c_str(),
                  dir.c_str());
   }
@@ -380,6 +404,14 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   const std::size_t first = cp.solved;
   int newton_total = 0;
   for (const auto& s : cp.samples) newton_total += s.at("newton_iterations").get<int>();
+  // Energy bookkeeping and the interface state of the previous sample (for the modes), restored
+  // from the last sample record on resume.
+  EnergyBookkeeping energy;
+  reference::CohesiveSampleState previous_interface;
+  if (!cp.samples.empty() && cp.samples.back().contains("energy")) {
+    energy = EnergyBookkeeping::from_json(cp.samples.back().at("energy"));
+    previous_interface = {cp.samples.back().at("contact_points").get<int>() > 0, cp.samples.back().at("energy").at("failed_area_m2").get<double>()};
+  }
   for (std::size_t i = cp.solved; i < indices.size(); ++i) {
     const std::size_t k = indices[i];
     reference::LoadStepReport step;
@@ -388,7 +420,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
       step = path.advance({load, k, rp.times[k]});
     } catch (const reference::LoadPathError& e) {
       stop = e.what();
-      std::fprintf(stderr, "reference %s: stopped: %s\n", scene.name.c_str(), e.what());
+      if (writer) std::fprintf(stderr, "reference %s: stopped: %s\n", scene.name.c_str(), e.what());
       break;
     }
     Eigen::Vector3d tool_force = step.tool_force + Eigen::Vector3d::Zero(); // −0 → 0
@@ -411,6 +443,13 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     const bool touching = tied ? tool_force.norm() > 0.0
                                : step.equilibrium.contact_points + step.equilibrium.edge_contact_points > 0;
     row.mode = touching ? InteractionMode::deformation_1 : InteractionMode::no_contact;
+    const reference::CohesiveSampleState interface{touching, step.equilibrium.cohesive.failed_area};
+    if (crack.active) {
+      row.mode = reference::reference_mode(previous_interface, interface);
+      row.crack_extent = solver.crack_extent(crack_direction);
+    }
+    previous_interface = interface;
+    energy.add_sample({rp.positions[k]}, {-tool_force}, solver.strain_energy(), step.equilibrium.cohesive);
     row.cost_s = cost;
     cp.profile.rows.push_back(row);
     cp.samples.push_back({{"index", k},
@@ -426,32 +465,36 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                           {"force_imbalance_N", vec_json(step.equilibrium.force_imbalance)},
                           {"contact_points", step.equilibrium.contact_points},
                           {"edge_contact_points", step.equilibrium.edge_contact_points},
-                          {"edge_contact_length_m", step.equilibrium.edge_contact_length}});
+                          {"edge_contact_length_m", step.equilibrium.edge_contact_length},
+                          {"energy", energy.to_json()}});
     cp.solve_seconds += cost;
     newton_total += step.newton_iterations;
     cp.solved = i + 1;
     cp.last = path.last_converged_load();
     if (settings.write_fields) {
-      write_atomically(dir / "fields" / step_name(i),
-                       [&](const fs::path& tmp) { solver.write_fields(tmp, load); });
-      write_pvd(dir, solved_times, cp.solved);
+      if (pieces)
+        solver.write_fields(dir / "fields" / step_name(i, true), load); // collective; atomic inside
+      else if (writer)
+        write_atomically(dir / "fields" / step_name(i, false), [&](const fs::path& tmp) { solver.write_fields(tmp, load); });
+      if (writer) write_pvd(dir, solved_times, cp.solved, pieces);
     }
     if (cp.solved % static_cast<std::size_t>(settings.checkpoint_every) == 0) {
       cp.state = path.last_converged_state();
-      write_checkpoint(cp, checkpoint_file);
+      if (writer) write_checkpoint(cp, checkpoint_file);
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - run_begin).count();
     const double eta = elapsed / static_cast<double>(cp.solved - first) * static_cast<double>(indices.size() - cp.solved);
-    std::fprintf(stderr,
-                 "reference %s: sample %zu/%zu (#%zu, t = %.4f s) tool (%.3f, %.3f, %.3f) mm, %d Newton its, "
-                 "%d cut-backs, |R| %.2e N, |F| %.4g N, elapsed %.1f s, ETA %.1f s\n",
-                 scene.name.c_str(), cp.solved, indices.size(), k, rp.times[k], rp.positions[k].x() * 1e3,
-                 rp.positions[k].y() * 1e3, rp.positions[k].z() * 1e3, step.newton_iterations, step.cutbacks,
-                 step.final_residual, tool_force.norm(), elapsed, eta);
+    if (writer)
+      std::fprintf(stderr,
+                   "reference %s: sample %zu/%zu (#%zu, t = %.4f s) tool (%.3f, %.3f, %.3f) mm, %d Newton its, "
+                   "%d cut-backs, |R| %.2e N, |F| %.4g N, elapsed %.1f s, ETA %.1f s\n",
+                   scene.name.c_str(), cp.solved, indices.size(), k, rp.times[k], rp.positions[k].x() * 1e3,
+                   rp.positions[k].y() * 1e3, rp.positions[k].z() * 1e3, step.newton_iterations, step.cutbacks,
+                   step.final_residual, tool_force.norm(), elapsed, eta);
   }
   if (!stop.empty()) {
     cp.state = path.last_converged_state();
-    write_checkpoint(cp, checkpoint_file); // the last converged state, saved
+    if (writer) write_checkpoint(cp, checkpoint_file); // the last converged state, saved
   }
 
   nlohmann::json m;
@@ -475,6 +518,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   nlohmann::json solver_json = {{"dofs", solver.dof_count()},
                                 {"cells", solver.cell_count()},
                                 {"linear_solver", solver.linear_solver_name()},
+                                {"mpi_processes", solver.process_count()},
                                 {"relative_tolerance", solver_settings.relative_tolerance},
                                 {"max_newton_iterations", solver_settings.max_newton_iterations},
                                 {"max_cutbacks", reference::LoadPathSettings{}.max_cutbacks},
@@ -491,11 +535,23 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                   {"solve_total_s", cp.solve_seconds},
                   {"samples_solved", cp.solved}};
   m["newton_iterations_total"] = newton_total;
+  m["energy"] = energy.to_json();
+  m["fracture"] = crack.active ? nlohmann::json{{"cohesive_law", "bilinear (Camacho-Ortiz effective opening), reference/cohesive/cohesive_law.hpp"},
+                                                {"cohesive_strength_Pa", scene.material.cohesive_strength},
+                                                {"fracture_toughness_J_per_m2", scene.material.fracture_toughness},
+                                                {"interface_triangles", crack.interface_triangles},
+                                                {"cohesive_zone_length_m", crack.zone_length},
+                                                {"elements_in_zone", crack.elements_in_zone},
+                                                {"warning", crack.warning}}
+                               : nlohmann::json(nullptr);
   m["samples"] = cp.samples;
   m["stopped"] = stop.empty() ? nlohmann::json(nullptr) : nlohmann::json(stop);
   m["resumed_after_sample"] = resumed_from ? nlohmann::json(*resumed_from) : nlohmann::json(nullptr);
-  write_profile_csv(cp.profile, dir / "profile.csv");
-  write_manifest(m, dir / "manifest.json");
+  if (writer) {
+    write_profile_csv(cp.profile, dir / "profile.csv");
+    write_manifest(m, dir / "manifest.json");
+  }
+  reference::wait_for_processes(); // the files are in place when any process returns
   return cp.profile;
 }
 

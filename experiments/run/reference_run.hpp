@@ -7,6 +7,7 @@
 // Includes reference/*.hpp only, which include no deal.II.
 
 #include "experiments/profile/force_profile.hpp"
+#include "experiments/run/reference_fracture.hpp"
 #include "experiments/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "reference/finite_strain_solver.hpp"
@@ -29,6 +30,14 @@ struct ReferenceRunSettings {
   bool write_fields = true; ///< dir/fields.pvd + dir/fields/step_NNNN.vtu
   int checkpoint_every = 5; ///< write dir/checkpoint.bin after every this many solved samples (>= 1)
   bool resume = false;      ///< continue from dir/checkpoint.bin if it exists
+  reference::LinearSolverChoice linear_solver = reference::LinearSolverChoice::automatic;
+  /// Under `mpirun -np N` (N > 1): distribute the mesh over the N processes (true) or solve the
+  /// whole problem on every process (false). See reference::SolverSettings::distribute.
+  bool distribute = true;
+  /// Cohesive fracture along the scene's cut_plane (Reference II; reference_fracture.hpp).
+  /// Off by default until Reference II is complete (docs/cohesive-fracture.md, "Not yet done"): the
+  /// cohesive reference of a cutting scene is opt-in (`--fracture auto|on`).
+  ReferenceFracture fracture = ReferenceFracture::off;
 };
 
 /// How the scene's tool is coupled to the body in the reference.
@@ -70,7 +79,12 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh);
 /// stops (cut-backs exhausted), returns the profile up to the last converged sample and records
 /// the stop message in the manifest. Writes dir/profile.csv, dir/manifest.json, fields and
 /// checkpoints; prints a progress line per sample on stderr. Throws std::invalid_argument on bad
-/// settings, std::runtime_error on an unreadable or mismatched checkpoint.
+/// settings, std::runtime_error on an unreadable or mismatched checkpoint (another scene, degree,
+/// refinement, sample set or process count).
+///
+/// Under `mpirun -np N`: collective (every process calls it and gets the same profile); rank 0
+/// alone writes profile.csv, manifest.json, checkpoint.bin and fields.pvd and prints the progress;
+/// distributed fields are fields/step_NNNN.pvtu with one .vtu piece per process.
 ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings,
                            const std::filesystem::path& dir);
 

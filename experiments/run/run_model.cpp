@@ -109,8 +109,15 @@ nlohmann::json run_manifest(const Scene& scene, const BuiltModel& model, const T
   return m;
 }
 
-void write_run(const std::filesystem::path& dir, const ForceProfile& profile, const nlohmann::json& manifest) {
+void write_run(const std::filesystem::path& dir, const ForceProfile& profile, const nlohmann::json& manifest,
+               const BuiltModel* model) {
   write_profile_csv(profile, dir / "profile.csv");
+  if (model && model->write_outputs) {
+    nlohmann::json with_outputs = manifest;
+    with_outputs.update(model->write_outputs(dir));
+    write_manifest(with_outputs, dir / "manifest.json");
+    return;
+  }
   write_manifest(manifest, dir / "manifest.json");
 }
 

@@ -36,8 +36,10 @@ CostStatistics cost_statistics(const ForceProfile& profile);
 nlohmann::json run_manifest(const Scene& scene, const BuiltModel& model, const TetMesh& mesh,
                             const ForceProfile& profile, double wall_seconds);
 
-/// What `kerf run` writes: DIR/profile.csv and DIR/manifest.json, each atomically.
-void write_run(const std::filesystem::path& dir, const ForceProfile& profile, const nlohmann::json& manifest);
+/// What `kerf run` writes: DIR/profile.csv and DIR/manifest.json, each atomically; with `model`,
+/// also the model's own outputs (BuiltModel::write_outputs), whose entries join the manifest.
+void write_run(const std::filesystem::path& dir, const ForceProfile& profile, const nlohmann::json& manifest,
+               const BuiltModel* model = nullptr);
 
 /// Samples every tool's trajectory of the scene, in scene order.
 std::vector<SampledTrajectory> sample_scene_trajectories(const Scene& scene);

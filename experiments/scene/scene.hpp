@@ -86,6 +86,24 @@ struct VoxelModelSettings {
   bool clip_friction = true;            ///< CFF of paper 002 Eq. (1) on (case d) or off (a, c)
 };
 
+/// Calibrated setting of the spring-network model (paper 000 §2), [models.springs]; written by
+/// `kerf calibrate` (docs/studies.md).
+struct SpringsModelSettings {
+  /// Factor on the Young's modulus the network's spring constants are identified from (paper 000
+  /// §2.1 identifies them from E and ν of the continuum; a coarse network around the stylus is
+  /// stiffer or softer than the body it stands for, and calibration fits this factor) [–] > 0.
+  double stiffness_scale = 1.0;
+  // The network's own settings (docs/scenes.md, [models.springs]); absent ones take the model's
+  // defaults or the material's values.
+  std::optional<int> cells;              ///< N: cells per side of the block around the styluses (>= 1; default 8)
+  std::optional<double> cell_size;       ///< h [m] > 0; absent or "auto": the block side over N
+  std::optional<std::string> integrator; ///< "explicit", "implicit" or "static" (default explicit; --integrator overrides)
+  std::optional<bool> volume_term;       ///< per-cell volume term (default on; represents ν >= 1/4)
+  std::optional<double> tensile_limit;   ///< tearing stress limit σ_max [Pa] > 0 (default: material cohesive_strength)
+  std::optional<double> damping;         ///< Kelvin–Voigt viscosity η [Pa s] >= 0 (default: material damping)
+  std::optional<double> grasp_radius;    ///< nodes within it of a stylus tip centre are attached [m] > 0 (default r + h/2)
+};
+
 struct Scene {
   std::filesystem::path file;        ///< the scene file as given
   std::string name;
@@ -98,6 +116,7 @@ struct Scene {
   std::vector<Tool> tools;           ///< one or two
   std::optional<FractureResponseParameters> fracture;  ///< [models.fracture]
   std::optional<VoxelModelSettings> voxel;             ///< [models.voxel]
+  std::optional<SpringsModelSettings> springs;         ///< [models.springs]
 };
 
 } // namespace kerf

@@ -119,9 +119,9 @@ constexpr double pi = std::numbers::pi;
 /// Reads one scene file; every error names file:line:column and the key path.
 class SceneParser {
 public:
-  explicit SceneParser(const fs::path& file)
+  SceneParser(const fs::path& file, std::vector<fs::path> extra_includes)
       : m_file(file), m_display(file.string()),
-        m_folder(fs::absolute(file).lexically_normal().parent_path()) {}
+        m_folder(fs::absolute(file).lexically_normal().parent_path()), m_extra_includes(std::move(extra_includes)) {}
 
   Scene read() {
     std::ifstream in(m_file, std::ios::binary);
@@ -140,7 +140,8 @@ public:
     top.begin = {1, 1};
     top.end = {1, 1};
     const TableRef doc{root, "", top};
-    allow_only(doc, {"scene", "geometry", "material", "layers", "supports", "tools", "models"});
+    allow_only(doc, {"scene", "geometry", "material", "layers", "supports", "tools", "models", "include"});
+    include_parameter_files(doc, root);
 
     Scene scene;
     scene.file = m_file;
@@ -151,9 +152,10 @@ public:
     read_supports(doc, scene);
     read_tools(doc, scene);
     if (const auto models = optional_table(doc, "models")) {
-      allow_only(*models, {"fracture", "voxel"});
+      allow_only(*models, {"fracture", "voxel", "springs"});
       if (const auto t = optional_table(*models, "fracture")) scene.fracture = read_fracture(*t);
       if (const auto t = optional_table(*models, "voxel")) scene.voxel = read_voxel(*t);
+      if (const auto t = optional_table(*models, "springs")) scene.springs = read_springs(*t);
     }
     check_consistency(scene);
     return scene;
@@ -163,6 +165,7 @@ private:
   fs::path m_file;
   std::string m_display;
   fs::path m_folder;
+  std::vector<fs::path> m_extra_includes; ///< parameter files given by the caller, after the scene's own
   /// The [scene].phenomena entries, for consistency errors at the right place.
   struct PhenomenonEntry {
     Phenomenon phenomenon;
@@ -190,10 +193,12 @@ private:
 
   // --- messages -------------------------------------------------------------------------------
 
+  /// "FILE:LINE:COLUMN", FILE the included parameter file when the node came from one.
   [[nodiscard]] std::string position(const toml::source_region& at) const {
     const unsigned line = at.begin.line == 0 ? 1u : at.begin.line;
     const unsigned column = at.begin.column == 0 ? 1u : at.begin.column;
-    return m_display + ":" + std::to_string(line) + ":" + std::to_string(column);
+    const std::string file = at.path && !at.path->empty() ? *at.path : m_display;
+    return file + ":" + std::to_string(line) + ":" + std::to_string(column);
   }
 
   [[noreturn]] void fail(const toml::source_region& at, std::string_view key, std::string_view message) const {
@@ -357,6 +362,66 @@ private:
       looked += c.lexically_normal().string();
     }
     fail(where(*t.find(key), t), t.key(key), "file \"" + name + "\" not found (looked for: " + looked + ")");
+  }
+
+  // --- included parameter files ---------------------------------------------------------------
+
+  /// `include = "FILE.toml"` or `include = ["A.toml", "B.toml"]` (resolved against the scene's
+  /// folder), then the caller's extra files: each parameter file holds [models.*] tables only —
+  /// calibrated model parameters (`kerf calibrate`) — and its keys replace the scene's keys of
+  /// the same table, in order. Geometry, material, supports and tools stay in the scene itself,
+  /// so an include never changes what the reference solves (nor its cache key). Its values are
+  /// read, unit-converted and checked below as if written in the scene; errors name the
+  /// parameter file's line.
+  void include_parameter_files(const TableRef& doc, toml::table& root) const {
+    std::vector<fs::path> files;
+    if (const toml::node* n = doc.find("include")) {
+      const std::string expected = "a parameter file name or an array of them";
+      std::vector<const toml::node*> names;
+      if (const toml::array* a = n->as_array()) {
+        for (const toml::node& e : *a) names.push_back(&e);
+      } else {
+        names.push_back(n);
+      }
+      for (const toml::node* e : names) {
+        const auto* s = e->as_string();
+        if (s == nullptr || s->get().empty()) wrong(*e, doc, "include", expected);
+        files.push_back(resolve_file(doc, "include", s->get(), {}));
+      }
+    }
+    for (const fs::path& f : m_extra_includes) files.push_back(f);
+    for (const fs::path& file : files) merge_parameter_file(root, file);
+    root.erase("include");
+  }
+
+  void merge_parameter_file(toml::table& root, const fs::path& file) const {
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw SceneError(m_display + ": include: cannot open the parameter file " + file.string());
+    std::ostringstream text;
+    text << in.rdbuf();
+    toml::table included;
+    try {
+      included = toml::parse(text.str(), file.string());
+    } catch (const toml::parse_error& e) {
+      throw SceneError(position(e.source()) + ": TOML syntax: " + std::string(e.description()));
+    }
+    for (auto&& [key, value] : included) {
+      if (key.str() != "models" || !value.is_table())
+        fail(key.source().begin.line != 0 ? key.source() : value.source(), key.str(),
+             "a parameter file holds [models.*] tables only (calibrated model parameters; geometry, material, "
+             "supports and tools stay in the scene)");
+      if (!root.contains("models")) root.insert("models", toml::table{});
+      toml::table* models = root["models"].as_table();
+      if (models == nullptr) return; // the scene's own "models" is not a table: reported where it is read
+      for (auto&& [model, section] : *value.as_table()) {
+        if (!section.is_table()) fail(section.source(), "models." + std::string(model.str()), "expected a table [models." + std::string(model.str()) + "]");
+        if (!models->contains(model.str())) models->insert(model.str(), toml::table{});
+        toml::table* into = (*models)[model.str()].as_table();
+        if (into == nullptr) continue; // reported where the scene's value is read
+        // Moved, not copied: toml++ keeps a node's source position only when it is moved.
+        for (auto&& [k, v] : *section.as_table()) into->insert_or_assign(k.str(), std::move(v));
+      }
+    }
   }
 
   // --- sections -------------------------------------------------------------------------------
@@ -673,6 +738,44 @@ private:
     return v;
   }
 
+  SpringsModelSettings read_springs(const TableRef& t) const {
+    allow_only(t, {"stiffness_scale", "cells", "cell_size", "integrator", "volume_term", "tensile_limit", "damping",
+                   "grasp_radius"});
+    SpringsModelSettings s;
+    if (const auto v = optional_quantity(t, "stiffness_scale", Dimension::dimensionless)) {
+      s.stiffness_scale = *v;
+      check(*v > 0.0, t, "stiffness_scale", "a factor > 0");
+    }
+    if (t.find("cells") != nullptr) {
+      s.cells = required_integer(t, "cells");
+      check(*s.cells >= 1 && *s.cells <= 64, t, "cells", "a cell count per side in 1 .. 64");
+    }
+    if (const toml::node* n = t.find("cell_size")) {
+      const auto* text = n->as_string();
+      if (text == nullptr || text->get() != "auto") {
+        s.cell_size = required_quantity(t, "cell_size", Dimension::length);
+        check(*s.cell_size > 0.0, t, "cell_size", "a length > 0 or \"auto\"");
+      }
+    }
+    if (const auto integrator = optional_string(t, "integrator")) {
+      if (*integrator != "explicit" && *integrator != "implicit" && *integrator != "static")
+        wrong(*t.find("integrator"), t, t.key("integrator"), "\"explicit\", \"implicit\" or \"static\"");
+      s.integrator = *integrator;
+    }
+    if (const toml::node* n = t.find("volume_term")) {
+      const auto* b = n->as_boolean();
+      if (b == nullptr) wrong(*n, t, t.key("volume_term"), "true or false");
+      s.volume_term = b->get();
+    }
+    if ((s.tensile_limit = optional_quantity(t, "tensile_limit", Dimension::pressure)))
+      check(*s.tensile_limit > 0.0, t, "tensile_limit", "a stress > 0");
+    if ((s.damping = optional_quantity(t, "damping", Dimension::viscosity)))
+      check(*s.damping >= 0.0, t, "damping", "a viscosity >= 0");
+    if ((s.grasp_radius = optional_quantity(t, "grasp_radius", Dimension::length)))
+      check(*s.grasp_radius > 0.0, t, "grasp_radius", "a length > 0");
+    return s;
+  }
+
   // --- the scene as a whole ---------------------------------------------------------------------
 
   /// Fails at the entry of scene.phenomena that declares `p`.
@@ -703,6 +806,8 @@ private:
 
 } // namespace
 
-Scene read_scene(const fs::path& file) { return SceneParser(file).read(); }
+Scene read_scene(const fs::path& file, const std::vector<fs::path>& parameter_files) {
+  return SceneParser(file, parameter_files).read();
+}
 
 } // namespace kerf

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace kerf {
 
@@ -18,8 +19,10 @@ public:
 
 /// Reads and validates a scene file. Unknown keys, missing fields, wrong units, non-finite or
 /// out-of-range values, a missing geometry or trajectory file, and inconsistent tools are
-/// SceneErrors naming file:line:column and the key.
-Scene read_scene(const std::filesystem::path& file);
+/// SceneErrors naming file:line:column and the key. `parameter_files` are included after the
+/// scene's own `include = ...` (docs/scenes.md, "Including parameter files"): each holds
+/// [models.*] tables whose keys replace the scene's (calibrated model parameters).
+Scene read_scene(const std::filesystem::path& file, const std::vector<std::filesystem::path>& parameter_files = {});
 
 /// Directories searched for a scene's `geo = "NAME.geo"` after the scene file's own folder:
 /// the kerf source tree's meshes/geo (compiled in) and $KERF_GEO_PATH if set.

@@ -10,6 +10,11 @@
       error against cost per sample for every row of a study table, log-log, with the 1 kHz and
       10 kHz servo budgets (1 ms and 100 us per sample) marked; writes OUT_STEM.png and .pdf.
 
+  plot_study.py stability OUT_STEM MODEL=STABILITY.csv [MODEL=STABILITY.csv ...]
+      the stability map of `kerf stability`: one panel per swept axis, the axis value (factor on
+      the nominal scene, or Poisson's ratio) across, one row per model, each run marked by its
+      class (bounded / oscillating / diverged / NaN / refused); writes OUT_STEM.png and .pdf.
+
 Files are written beside their final name and renamed, so a reader never sees half a plot.
 """
 import argparse
@@ -118,6 +123,54 @@ def plot_pareto(stem, table, error_column, cost_column, label_column):
     save(fig, stem)
 
 
+STABILITY_STYLE = {
+    "bounded": ("#2ca02c", "o"),
+    "oscillating": ("#ff7f0e", "s"),
+    "diverged": ("#d62728", "^"),
+    "NaN": ("#000000", "X"),
+    "refused": ("#7f7f7f", "D"),
+}
+
+
+def plot_stability(stem, runs):
+    maps = []  # (model, rows)
+    for model, path in runs:
+        with open(path, newline="", encoding="utf-8") as f:
+            rows = list(csv.DictReader(f))
+        if not rows or "axis" not in rows[0] or "outcome" not in rows[0]:
+            sys.exit(f"{path}: not a kerf stability table (columns axis, value, outcome)")
+        maps.append((model, rows))
+    axes = []
+    for _, rows in maps:
+        for r in rows:
+            if r["axis"] not in axes:
+                axes.append(r["axis"])
+    fig, panels = plt.subplots(1, len(axes), figsize=(2.6 * len(axes), 0.5 * len(maps) + 1.8), sharey=True,
+                               squeeze=False)
+    for panel, axis in zip(panels[0], axes):
+        for y, (model, rows) in enumerate(maps):
+            for r in rows:
+                if r["axis"] != axis:
+                    continue
+                colour, marker = STABILITY_STYLE.get(r["outcome"], ("#1f77b4", "?"))
+                panel.scatter([float(r["value"])], [y], c=colour, marker=marker, s=45, zorder=3)
+        if axis != "poisson":
+            panel.set_xscale("log")
+            panel.axvline(1.0, color="grey", lw=0.8, ls=":")  # the nominal scene
+            panel.set_xlabel("factor on nominal")
+        else:
+            panel.set_xlabel("Poisson's ratio")
+        panel.set_title(axis, fontsize=9)
+        panel.grid(alpha=0.3, which="both")
+        panel.set_yticks(range(len(maps)))
+        panel.set_yticklabels([m for m, _ in maps])
+        panel.set_ylim(-0.6, len(maps) - 0.4)
+    handles = [plt.Line2D([0], [0], color="w", marker=m, markerfacecolor=c, markersize=8, label=name)
+               for name, (c, m) in STABILITY_STYLE.items()]
+    fig.legend(handles=handles, loc="lower center", ncol=len(handles), fontsize=8, bbox_to_anchor=(0.5, 1.0))
+    save(fig, stem)
+
+
 def main(argv):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="kind", required=True)
@@ -131,8 +184,18 @@ def main(argv):
     q.add_argument("--error", required=True)
     q.add_argument("--cost", required=True)
     q.add_argument("--label", required=True)
+    t = sub.add_parser("stability")
+    t.add_argument("stem")
+    t.add_argument("runs", nargs="+", help="MODEL=STABILITY.csv")
     args = parser.parse_args(argv)
-    if args.kind == "profiles":
+    if args.kind == "stability":
+        runs = []
+        for item in args.runs:
+            if "=" not in item:
+                sys.exit(f"expected MODEL=STABILITY.csv, got {item!r}")
+            runs.append(tuple(item.split("=", 1)))
+        plot_stability(args.stem, runs)
+    elif args.kind == "profiles":
         runs = []
         for item in args.runs:
             if "=" not in item:

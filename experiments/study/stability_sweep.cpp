@@ -4,7 +4,9 @@
 #include "experiments/run/run_model.hpp"
 #include "experiments/run/scene_mesh.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <stdexcept>
 
@@ -153,6 +155,52 @@ std::vector<StabilityPoint> stability_sweep(const Scene& nominal, const std::str
       points.push_back(std::move(p));
     }
   return points;
+}
+
+std::string stability_edges(const std::vector<StabilityPoint>& points) {
+  const auto shown = [](const std::string& axis, double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, axis == "poisson" ? "ν = %g" : "×%g", v);
+    return std::string(b);
+  };
+  std::vector<std::string> axes;
+  for (const StabilityPoint& p : points)
+    if (std::find(axes.begin(), axes.end(), p.axis) == axes.end()) axes.push_back(p.axis);
+  std::string out;
+  for (const std::string& axis : axes) {
+    std::vector<const StabilityPoint*> mine;
+    for (const StabilityPoint& p : points)
+      if (p.axis == axis) mine.push_back(&p);
+    std::sort(mine.begin(), mine.end(), [](auto a, auto b) { return a->value < b->value; });
+    std::vector<const StabilityPoint*> bounded, other;
+    for (const StabilityPoint* p : mine) (p->outcome == StabilityClass::bounded ? bounded : other).push_back(p);
+    out += "- " + axis + " " + shown(axis, mine.front()->value) + " … " + shown(axis, mine.back()->value) + ": ";
+    if (other.empty()) {
+      out += "bounded at all " + std::to_string(mine.size()) + "\n";
+      continue;
+    }
+    out += bounded.empty() ? "bounded at none"
+                           : "bounded at " + (bounded.size() == 1 ? shown(axis, bounded.front()->value)
+                                                                  : shown(axis, bounded.front()->value) + " … " +
+                                                                        shown(axis, bounded.back()->value)) +
+                                 " (" + std::to_string(bounded.size()) + " of " + std::to_string(mine.size()) + ")";
+    for (const StabilityPoint* p : other) {
+      char detail[96] = "";
+      if (p->outcome == StabilityClass::oscillating)
+        std::snprintf(detail, sizeof detail, " (%.0f %% reversing)", 100.0 * p->reversal_fraction);
+      else if (p->outcome == StabilityClass::diverged)
+        std::snprintf(detail, sizeof detail, " (peak %.3g N, %.0f× the scale)", p->peak_force, p->peak_force / p->expected_scale);
+      out += "; " + shown(axis, p->value) + " " + std::string(to_string(p->outcome)) + detail;
+      if (p->outcome == StabilityClass::refused) {
+        std::string why = p->note.substr(0, 140);
+        for (char& c : why)
+          if (c == '\n' || c == '|') c = ' ';
+        out += " (\"" + why + (p->note.size() > 140 ? "…" : "") + "\")";
+      }
+    }
+    out += "\n";
+  }
+  return out;
 }
 
 } // namespace kerf

@@ -56,6 +56,13 @@ struct StabilityPoint {
 /// Throws std::invalid_argument for an unknown axis.
 Scene scaled_scene(const Scene& nominal, const std::string& axis, double value);
 
+/// The documented edge of a model: one Markdown list item per axis, in sweep order, naming the
+/// tested values where the model stayed bounded and every value where it did not, with the class
+/// (and, for a refusal, its message): "- stiffness ×1e-3 … ×1e3: bounded at all 6" or
+/// "- rate ×0.25 … ×16: bounded at ×0.5 … ×16; ×0.25 oscillating (38 % reversing)". Factors are
+/// on the nominal scene; Poisson's ratio is absolute.
+std::string stability_edges(const std::vector<StabilityPoint>& points);
+
 /// Runs `model` on the nominal scene and on every point of the sweep and classifies each run.
 /// Throws only if the nominal run itself fails (the sweep then has no scale to judge by).
 std::vector<StabilityPoint> stability_sweep(const Scene& nominal, const std::string& model,

@@ -45,4 +45,11 @@ void plot_pareto(const std::filesystem::path& stem, const std::filesystem::path&
                    "--label", label_column});
 }
 
+void plot_stability(const std::filesystem::path& stem,
+                    const std::vector<std::pair<std::string, std::filesystem::path>>& runs) {
+  std::vector<std::string> args{"stability", stem.string()};
+  for (const auto& [model, csv] : runs) args.push_back(model + "=" + csv.string());
+  run_plot_script(args);
+}
+
 } // namespace kerf

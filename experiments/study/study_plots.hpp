@@ -19,4 +19,9 @@ void plot_profiles(const std::filesystem::path& stem,
 void plot_pareto(const std::filesystem::path& stem, const std::filesystem::path& table_csv, const std::string& error_column,
                  const std::string& cost_column, const std::string& label_column);
 
+/// The stability map (kerf stability): per swept axis, the value against the class of each run,
+/// one row per (model, stability.csv) given: STEM.png and STEM.pdf.
+void plot_stability(const std::filesystem::path& stem,
+                    const std::vector<std::pair<std::string, std::filesystem::path>>& runs);
+
 } // namespace kerf

@@ -7,12 +7,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include "meshes/atomic_file.hpp"
+
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <sstream>
+#include <thread>
 
 namespace kerf {
 
@@ -85,30 +90,171 @@ std::string cache_key(const Scene& scene, const StudyReferenceSpec& r, int level
 
 } // namespace
 
-StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference) {
-  namespace fs = std::filesystem;
-  StudyResult result;
-  for (const fs::path& scene_file : spec.scenes) {
-    const Scene scene = read_scene(scene_file);
-    const TetMesh mesh = scene_mesh(scene);
-    const auto trajectories = sample_scene_trajectories(scene);
-    std::size_t n = 0;
-    for (const auto& t : trajectories) n = std::max(n, t.samples.size());
+namespace {
 
-    // The reference at every level, cached by scene hash and settings.
-    std::map<int, ForceProfile> references;
-    const auto indices = reference_sample_indices(n, spec.reference.samples);
-    if (spec.has_reference && reference) {
-      for (int level : spec.reference.refinements) {
-        const fs::path cached = out / "cache" / cache_key(scene, spec.reference, level);
-        if (fs::exists(cached / "profile.csv")) {
-          references[level] = read_profile_csv(cached / "profile.csv");
-        } else {
-          references[level] = reference(scene, spec.reference, level, indices, cached);
-          ++result.reference_runs;
-          if (!fs::exists(cached / "profile.csv")) write_profile_csv(references[level], cached / "profile.csv");
+/// One fast-model run of a study: the model on a scene (with calibrated parameters for a
+/// "MODEL (calibrated)" row), its profile under `dir`.
+struct ModelRun {
+  std::size_t scene = 0;  ///< index into the planned scenes
+  std::string model;      ///< catalogue name
+  std::string label;      ///< the table's model column
+  Scene scene_with_parameters;
+  std::filesystem::path dir;
+};
+
+struct PlannedScene {
+  Scene scene;
+  std::vector<std::size_t> indices; ///< trajectory samples the reference solves
+  std::vector<std::pair<int, std::filesystem::path>> levels; ///< (mesh level, cache directory)
+};
+
+void write_text(const std::filesystem::path& file, const std::string& text) {
+  std::filesystem::create_directories(file.parent_path());
+  write_atomically(file, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp);
+    f << text;
+    if (!f.flush()) throw std::runtime_error(file.string() + ": write failed");
+  });
+}
+
+std::string read_text(const std::filesystem::path& file) {
+  std::ifstream f(file);
+  std::ostringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+/// Runs `tasks` on `jobs` threads; each task catches its own failures.
+void run_tasks(const std::vector<std::function<void()>>& tasks, int jobs) {
+  std::atomic<std::size_t> next{0};
+  std::mutex failure_mutex;
+  std::exception_ptr failure;
+  const auto worker = [&] {
+    for (std::size_t k = next++; k < tasks.size(); k = next++) {
+      try {
+        tasks[k]();
+      } catch (...) {
+        const std::lock_guard lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  const auto threads = static_cast<std::size_t>(std::max(1, jobs));
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < std::min(threads, tasks.size()); ++t) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+  if (failure) std::rethrow_exception(failure);
+}
+
+} // namespace
+
+StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
+                      const StudyExecution& execution) {
+  namespace fs = std::filesystem;
+  if (execution.ranks > 1 && !execution.synchronise)
+    throw std::invalid_argument("run_study: " + std::to_string(execution.ranks) + " ranks need a synchronise function");
+  const auto synchronise = [&](int value) { return execution.ranks > 1 ? execution.synchronise(value) : value; };
+
+  // Plan (every rank the same): scenes, reference levels not yet cached, model runs.
+  std::vector<PlannedScene> scenes;
+  std::vector<ModelRun> model_runs;
+  for (const fs::path& scene_file : spec.scenes) {
+    PlannedScene planned{read_scene(scene_file), {}, {}};
+    const Scene& scene = planned.scene;
+    std::size_t n = 0;
+    for (const auto& t : sample_scene_trajectories(scene)) n = std::max(n, t.samples.size());
+    planned.indices = reference_sample_indices(n, spec.reference.samples);
+    if (spec.has_reference && reference)
+      for (int level : spec.reference.refinements)
+        planned.levels.emplace_back(level, out / "cache" / cache_key(scene, spec.reference, level));
+    const std::size_t index = scenes.size();
+    for (const std::string& model : spec.models) {
+      try {
+        require_model_for_scene(model, scene);
+      } catch (const std::exception&) {
+        continue; // not applicable: not in the table
+      }
+      model_runs.push_back({index, model, model, scene, out / scene.name / model});
+      const auto calibrated = spec.calibrations.find(scene_file.stem().string());
+      if (calibrated == spec.calibrations.end()) continue;
+      for (const fs::path& parameters : calibrated->second) {
+        const auto models = calibrated_models(parameters);
+        if (std::find(models.begin(), models.end(), model) == models.end()) continue;
+        model_runs.push_back({index, model, model + " (calibrated)", read_scene(scene_file, {parameters}),
+                              out / scene.name / (model + "-calibrated")});
+      }
+    }
+    scenes.push_back(std::move(planned));
+  }
+  std::vector<std::pair<std::size_t, std::size_t>> reference_runs; // (scene, level index) not cached
+  for (std::size_t s = 0; s < scenes.size(); ++s)
+    for (std::size_t l = 0; l < scenes[s].levels.size(); ++l)
+      if (!fs::exists(scenes[s].levels[l].second / "profile.csv")) reference_runs.emplace_back(s, l);
+  synchronise(0); // every rank has looked at the cache before any rank writes to it
+
+  // This rank's share: run k (references first, then models) belongs to rank k mod ranks.
+  const auto mine = [&](std::size_t k) { return static_cast<int>(k % static_cast<std::size_t>(execution.ranks)) == execution.rank; };
+  std::vector<std::pair<std::size_t, std::size_t>> my_references;
+  for (std::size_t k = 0; k < reference_runs.size(); ++k)
+    if (mine(k)) my_references.push_back(reference_runs[k]);
+  std::vector<const ModelRun*> my_models;
+  for (std::size_t k = 0; k < model_runs.size(); ++k)
+    if (mine(reference_runs.size() + k)) my_models.push_back(&model_runs[k]);
+
+  // Meshes of the scenes this rank runs models on, made before the threads start.
+  std::map<std::size_t, TetMesh> meshes;
+  for (const ModelRun* run : my_models)
+    if (!meshes.count(run->scene)) meshes.emplace(run->scene, scene_mesh(scenes[run->scene].scene));
+
+  std::vector<std::function<void()>> tasks;
+  int solved = 0;
+  if (!my_references.empty())
+    tasks.emplace_back([&] { // one at a time: PETSc is not thread-safe
+      for (const auto& [s, l] : my_references) {
+        const auto& [level, cached] = scenes[s].levels[l];
+        fs::remove(cached / "error.txt");
+        try {
+          const ForceProfile p = reference(scenes[s].scene, spec.reference, level, scenes[s].indices, cached);
+          if (!fs::exists(cached / "profile.csv")) write_profile_csv(p, cached / "profile.csv");
+          ++solved;
+        } catch (const std::exception& e) {
+          write_text(cached / "error.txt", e.what());
         }
       }
+    });
+  for (const ModelRun* run : my_models)
+    tasks.emplace_back([&, run] {
+      fs::remove(run->dir / "profile.csv");
+      fs::remove(run->dir / "note.txt");
+      try {
+        const TetMesh& mesh = meshes.at(run->scene);
+        BuiltModel built = make_model(run->model, run->scene_with_parameters, mesh);
+        std::vector<std::string> names;
+        for (const Tool& t : run->scene_with_parameters.tools) names.push_back(t.name);
+        const auto begin = std::chrono::steady_clock::now();
+        const ForceProfile profile = run_model(*built.model, names, sample_scene_trajectories(run->scene_with_parameters));
+        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+        write_run(run->dir, profile, run_manifest(run->scene_with_parameters, built, mesh, profile, wall));
+      } catch (const std::exception& e) {
+        write_text(run->dir / "note.txt", e.what());
+      }
+    });
+  run_tasks(tasks, execution.jobs);
+
+  StudyResult result;
+  result.reference_runs = synchronise(solved);
+  if (execution.rank != 0) return result;
+
+  // Rank 0: the table, from what every rank wrote.
+  for (std::size_t s = 0; s < scenes.size(); ++s) {
+    const Scene& scene = scenes[s].scene;
+    std::map<int, ForceProfile> references;
+    for (const auto& [level, cached] : scenes[s].levels) {
+      if (!fs::exists(cached / "profile.csv"))
+        throw std::runtime_error("reference of scene " + scene.name + " at level " + std::to_string(level) + " failed: " +
+                                 (fs::exists(cached / "error.txt") ? read_text(cached / "error.txt") : "no profile written"));
+      references[level] = read_profile_csv(cached / "profile.csv");
     }
     const ForceProfile* finest = references.empty() ? nullptr : &references.rbegin()->second;
     const std::string tool = scene.tools.front().name;
@@ -125,21 +271,16 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       result.rows.push_back(std::move(row));
     }
 
-    for (const std::string& model : spec.models) {
-      StudyRow row{scene.name, model, std::nullopt, {}, ""};
-      try {
-        require_model_for_scene(model, scene);
-      } catch (const std::exception& e) {
-        continue; // not applicable: not in the table
+    for (const ModelRun& run : model_runs) {
+      if (run.scene != s) continue;
+      StudyRow row{scene.name, run.label, std::nullopt, {}, ""};
+      if (!fs::exists(run.dir / "profile.csv")) {
+        row.note = fs::exists(run.dir / "note.txt") ? read_text(run.dir / "note.txt") : "no profile written";
+        result.rows.push_back(std::move(row));
+        continue;
       }
       try {
-        BuiltModel built = make_model(model, scene, mesh);
-        std::vector<std::string> names;
-        for (const Tool& t : scene.tools) names.push_back(t.name);
-        const auto begin = std::chrono::steady_clock::now();
-        const ForceProfile profile = run_model(*built.model, names, trajectories);
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-        write_run(out / scene.name / model, profile, run_manifest(scene, built, mesh, profile, wall));
+        const ForceProfile profile = read_profile_csv(run.dir / "profile.csv");
         row.cost = cost_statistics(profile);
         if (finest)
           row.metrics = compare_profiles(at_common_times(profile, *finest), at_common_times(*finest, profile), tool,

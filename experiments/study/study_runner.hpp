@@ -44,9 +44,29 @@ struct StudyResult {
   int reference_runs = 0;     ///< reference solves actually run (0 on a fully cached re-run)
 };
 
+/// How the independent runs of a study are spread: over `jobs` threads of this process and over
+/// `ranks` processes (MPI, study_ranks.hpp). A run is a reference solve (scene, mesh level) or a
+/// fast model on a scene; run k (references first, then models, in study order) belongs to rank
+/// k mod ranks. Each rank runs its share, writing every result to disk (the reference cache, the
+/// model's profile.csv, or a note.txt saying why it failed); after `synchronise`, rank 0 reads them
+/// all back and builds the table — so the tables do not depend on jobs or ranks, apart from the
+/// cost columns (a step timed beside another run is slower). Reference solves of one process run
+/// one at a time (PETSc is not thread-safe), beside the fast models.
+struct StudyExecution {
+  int jobs = 1;   ///< threads for this process's runs, >= 1
+  int rank = 0;   ///< this process, in [0, ranks)
+  int ranks = 1;  ///< processes sharing the study
+  /// With ranks > 1: waits for every rank and returns the sum of `value` over the ranks
+  /// (MPI_Allreduce). Called twice: before any run (so every rank plans from the same cache) and
+  /// after this rank's share.
+  std::function<int(int value)> synchronise;
+};
+
 /// `reference` may be empty (no reference built): then only costs are reported. Every output
-/// goes under `out`; the reference cache lives in `out/cache`.
-StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference);
+/// goes under `out`; the reference cache lives in `out/cache`. Rank 0 returns the rows; other
+/// ranks return no rows (and the total reference runs). Throws if a reference solve failed.
+StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
+                      const StudyExecution& execution = {});
 
 /// The trajectory samples the reference solves: `count` indices evenly spaced over [0, n-1],
 /// first and last included.

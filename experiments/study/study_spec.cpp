@@ -53,7 +53,7 @@ StudySpec read_study(const std::filesystem::path& file) {
   }
   StudySpec spec;
   spec.file = file;
-  allow_only(file, doc, "", {"study", "reference"});
+  allow_only(file, doc, "", {"study", "reference", "calibration"});
   const toml::table* study = doc["study"].as_table();
   if (!study) throw StudyError(file.string() + ": missing table [study]");
   allow_only(file, *study, "study.", {"name", "description", "scenes", "models"});
@@ -96,7 +96,40 @@ StudySpec read_study(const std::filesystem::path& file) {
       spec.reference.samples = static_cast<int>(*v);
     }
   }
+  if (const toml::node* c = doc.get("calibration")) {
+    const toml::table* cal = c->as_table();
+    if (!cal) fail(file, c->source(), "calibration", "expected a table [calibration] of scene = [parameter files]");
+    for (const auto& [scene, files] : *cal) {
+      const std::string key = "calibration." + std::string(scene.str());
+      bool known = false;
+      for (const std::filesystem::path& f : spec.scenes) known = known || f.stem() == scene.str();
+      if (!known) fail(file, scene.source(), key, "no scene of that name in study.scenes");
+      const toml::array* a = files.as_array();
+      if (!a || a->empty()) fail(file, files.source(), key, "expected an array of parameter files");
+      for (const toml::node& n : *a) {
+        const auto name = n.value<std::string>();
+        const std::filesystem::path p = file.parent_path() / name.value_or("");
+        if (!name || !std::filesystem::is_regular_file(p)) fail(file, n.source(), key, "no parameter file \"" + name.value_or("") + "\" beside the study");
+        if (calibrated_models(p).empty()) fail(file, n.source(), key, p.string() + " has no [models.*] table");
+        spec.calibrations[std::string(scene.str())].push_back(p);
+      }
+    }
+  }
   return spec;
+}
+
+std::vector<std::string> calibrated_models(const std::filesystem::path& parameter_file) {
+  toml::table doc;
+  try {
+    doc = toml::parse_file(parameter_file.string());
+  } catch (const toml::parse_error& e) {
+    throw StudyError(parameter_file.string() + ":" + std::to_string(e.source().begin.line) + ":" +
+                     std::to_string(e.source().begin.column) + ": TOML syntax: " + std::string(e.description()));
+  }
+  std::vector<std::string> out;
+  if (const toml::table* models = doc["models"].as_table())
+    for (const auto& [name, section] : *models) out.emplace_back(name.str());
+  return out;
 }
 
 } // namespace kerf

@@ -117,7 +117,15 @@ SampledTrajectory read_recorded_trajectory(const std::filesystem::path& csv, dou
   SampledTrajectory out;
   out.rate = rate;
   const double t0 = times.front();
-  const auto count = static_cast<std::size_t>(std::floor((times.back() - t0) * rate + 1e-9)) + 1;
+  // At most 1e7 resampled points (2.8 h at 1 kHz, ~0.9 GB of states): a longer span is a wrong
+  // time column (e.g. nanoseconds), and its count must be checked before the size_t conversion.
+  const double intervals = std::floor((times.back() - t0) * rate + 1e-9);
+  if (!(intervals < 1e7))
+    throw std::runtime_error(csv.string() + ": the recorded trajectory spans " + std::to_string(times.back() - t0) +
+                             " s, over 1e7 samples at " + std::to_string(rate) + " Hz (is the time column in seconds?)");
+  const auto count = static_cast<std::size_t>(intervals) + 1;
+  out.samples.reserve(count);
+  out.labels.reserve(count);
   std::size_t j = 0;
   for (std::size_t k = 0; k < count; ++k) {
     const double t = t0 + static_cast<double>(k) / rate;

@@ -38,6 +38,44 @@ DiscreteEdgeCuttingModel::DiscreteEdgeCuttingModel(CollisionVoxels voxels, Discr
 void DiscreteEdgeCuttingModel::reset() {
   std::fill(m_points.begin(), m_points.end(), Point{});
   m_have_previous = false;
+  m_pass_open = false;
+  if (m_cut) m_cut->reset();
+}
+
+void DiscreteEdgeCuttingModel::attach_geometric_cut(std::unique_ptr<BackgroundCut> cut, double record_spacing) {
+  require(cut != nullptr, "the geometric cut to attach is missing");
+  require(record_spacing > 0.0 && std::isfinite(record_spacing), "record spacing must be positive");
+  m_cut = std::move(cut);
+  m_record_spacing = record_spacing;
+  m_pass_open = false;
+}
+
+void DiscreteEdgeCuttingModel::finish_geometric_cut() {
+  if (!m_cut) return;
+  if (m_pass_open) close_pass(m_last_front);
+  m_cut->wait_until_idle();
+}
+
+void DiscreteEdgeCuttingModel::close_pass(const Eigen::Vector3d& centre) noexcept {
+  if (m_cut->recorded() == 0 || m_last_front != m_cut->last_recorded()) m_cut->record(m_last_front);
+  if ((centre - m_last_front).dot(m_pass_inward) > 0.0) m_cut->record(centre); // on through the body
+  m_cut->submit();
+  m_pass_open = false;
+}
+
+void DiscreteEdgeCuttingModel::record_pass(const Eigen::Vector3d& centre, bool any_contact, int cut_points,
+                                           const Eigen::Vector3d& entry, const Eigen::Vector3d& front,
+                                           const Eigen::Vector3d& inward) noexcept {
+  if (cut_points > 0) {
+    if (!m_pass_open) {
+      m_cut->record(entry);
+      m_pass_open = true;
+      m_pass_inward = inward;
+    }
+    if (m_cut->recorded() == 0 || (front - m_cut->last_recorded()).norm() >= m_record_spacing) m_cut->record(front);
+    m_last_front = front;
+  }
+  if (m_pass_open && !any_contact) close_pass(centre);
 }
 
 double DiscreteEdgeCuttingModel::point_stiffness(int region) const {
@@ -152,6 +190,9 @@ void DiscreteEdgeCuttingModel::step(std::span<const ToolState> tools, double /*d
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
   bool any_cutting = false, any_fresh = false, any_in_cut = false;
   double crack_extent = 0.0;
+  bool any_contact = false;
+  int cut_points = 0;
+  Eigen::Vector3d entry = Eigen::Vector3d::Zero(), front = Eigen::Vector3d::Zero(), inward = Eigen::Vector3d::Zero();
   const double half = 0.5 * m_setup.edge_length;
   for (std::size_t i = 0; i < m_points.size(); ++i) {
     // p_i = c + s_i e, s_i the midpoint of the i-th of K equal pieces.
@@ -165,8 +206,23 @@ void DiscreteEdgeCuttingModel::step(std::span<const ToolState> tools, double /*d
       else any_fresh = true;
     }
     if (point.has_cut) crack_extent = std::max(crack_extent, point.depth);
+    any_contact = any_contact || point.in_contact;
+    if (point.in_contact && point.has_cut) { // the crack front and its entry, referred to the edge's centre
+      ++cut_points;
+      entry += point.entry - s * m_setup.edge_direction;
+      front += point.relaxed - s * m_setup.edge_direction;
+      inward += point.inward;
+    }
   }
   m_have_previous = true;
+  if (m_cut && total.allFinite()) {
+    if (cut_points > 0) {
+      entry /= cut_points;
+      front /= cut_points;
+      inward.normalize();
+    }
+    record_pass(c, any_contact, any_cutting ? cut_points : 0, entry, front, inward);
+  }
 
   if (!total.allFinite()) {
     ++m_non_finite;

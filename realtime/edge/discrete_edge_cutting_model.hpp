@@ -3,11 +3,13 @@
 // Deforming Operations) on a blade edge discretised into K independent points, with collision
 // through the voxel model of §3.3.
 
+#include "realtime/edge/background_cut.hpp"
 #include "realtime/edge/collision_voxels.hpp"
 #include "realtime/tool_model.hpp"
 
 #include <Eigen/Core>
 
+#include <memory>
 #include <vector>
 
 namespace kerf {
@@ -93,11 +95,32 @@ public:
   [[nodiscard]] const DiscreteEdgeSetup& setup() const { return m_setup; }
   [[nodiscard]] long non_finite_count() const { return m_non_finite; }
 
+  /// Paper 000 §3.2 driven by the edge itself: `step` records the trajectory of the edge where
+  /// it destroys material and hands each pass to `cut`'s worker thread (BackgroundCut: no
+  /// allocation, lock or wait on the servo thread). A pass opens at the first sample in which a
+  /// point cuts, with the edge's entry (the mean over cutting points of e_i - s_i e, e_i each
+  /// point's entry on the surface); while points cut it records the crack front, the mean of
+  /// r_i - s_i e over the points in contact that have cut (their relaxed points: where material
+  /// was destroyed), each time it has moved `record_spacing` [m] > 0 from the last position; it
+  /// closes when no point is in a marked voxel any more, with the last front and, when the edge
+  /// went on through the body (its centre ahead of the front along the direction of entry), the
+  /// edge's centre itself, and is handed over.
+  void attach_geometric_cut(std::unique_ptr<BackgroundCut> cut, double record_spacing);
+  /// The attached cut, or null.
+  [[nodiscard]] BackgroundCut* geometric_cut() const { return m_cut.get(); }
+  /// Not realtime: closes and hands over a pass still open (the trajectory ended inside the
+  /// body) and waits until the worker has cut.
+  void finish_geometric_cut();
+
 private:
   /// The surface point between `outside` (unmarked) and `inside` (marked), by bisection on the
   /// voxel marks (60 halvings: far below a voxel).
   [[nodiscard]] Eigen::Vector3d entry_point(const Eigen::Vector3d& outside, const Eigen::Vector3d& inside) const noexcept;
   void update_point(Point& point, const Eigen::Vector3d& p, const Eigen::Vector3d& velocity, bool have_previous) noexcept;
+  /// The trajectory recording of attach_geometric_cut, once per step.
+  void record_pass(const Eigen::Vector3d& centre, bool any_contact, int cut_points, const Eigen::Vector3d& entry,
+                   const Eigen::Vector3d& front, const Eigen::Vector3d& inward) noexcept;
+  void close_pass(const Eigen::Vector3d& centre) noexcept;
 
   CollisionVoxels m_voxels;
   DiscreteEdgeSetup m_setup;
@@ -105,6 +128,11 @@ private:
   std::vector<Point> m_points; ///< sized once
   bool m_have_previous = false;
   long m_non_finite = 0;
+  std::unique_ptr<BackgroundCut> m_cut;
+  double m_record_spacing = 0.0;
+  bool m_pass_open = false;
+  Eigen::Vector3d m_pass_inward = Eigen::Vector3d::Zero();
+  Eigen::Vector3d m_last_front = Eigen::Vector3d::Zero();
 };
 
 } // namespace kerf

@@ -38,13 +38,6 @@ FaceKey face_key(int a, int b, int c) {
   return {v};
 }
 
-/// A cross point on a mesh edge: its parameter from the lower-numbered node, and its two copies.
-struct EdgeCross {
-  double t = 0.0;
-  bool valid = false;
-  int plus = -1;
-  int minus = -1;
-};
 
 } // namespace
 
@@ -102,27 +95,43 @@ GeometricCutReport CuttableBody::cut(const SweptSurface& surface, const Geometri
     throw std::invalid_argument("geometric cut: snap tolerance must be in (0, 0.1)");
   if (!(options.reach > 0.0 && options.reach <= 1.0)) throw std::invalid_argument("geometric cut: reach must be in (0, 1]");
   GeometricCutReport report;
+  report.fragments = m_fragment_count;
+  report.min_volume_ratio = 1.0;
   const Eigen::Index node_count = m_mesh.nodes.rows();
-  auto position = [&](int g) { return Eigen::Vector3d(m_mesh.nodes.row(g)); };
+  const Eigen::Index tet_count = m_mesh.tets.rows();
+
+  // Nodes and tetrahedra made by this cut live beside the mesh until it is written back.
+  std::vector<Eigen::Vector3d> added_nodes;
+  std::vector<std::array<int, 4>> added_tets;
+  std::vector<int> added_origin; // the original tetrahedron each added one was divided from
+  auto position = [&](int g) -> Eigen::Vector3d {
+    return g < node_count ? Eigen::Vector3d(m_mesh.nodes.row(g)) : added_nodes[static_cast<std::size_t>(g - node_count)];
+  };
+  auto corner = [&](int t, int k) -> int& {
+    return t < tet_count ? m_mesh.tets(t, k) : added_tets[static_cast<std::size_t>(t - tet_count)][static_cast<std::size_t>(k)];
+  };
+  auto volume_of = [&](int t) {
+    return signed_tet_volume(position(corner(t, 0)), position(corner(t, 1)), position(corner(t, 2)), position(corner(t, 3)));
+  };
 
   // The surface's triangles, their unit normals, and its bounds.
-  const Eigen::Index triangle_count = surface.triangles.rows();
   std::vector<std::array<Eigen::Vector3d, 3>> triangles;
   std::vector<Eigen::Vector3d> normals;
   Eigen::AlignedBox3d surface_box;
-  for (Eigen::Index f = 0; f < triangle_count; ++f) {
+  for (Eigen::Index f = 0; f < surface.triangles.rows(); ++f) {
     std::array<Eigen::Vector3d, 3> tri;
-    for (int k = 0; k < 3; ++k) tri[static_cast<std::size_t>(k)] = surface.vertices.row(surface.triangles(f, k)).transpose();
+    for (int k = 0; k < 3; ++k) {
+      const int v = surface.triangles(f, k);
+      if (v < 0 || v >= surface.vertices.rows()) throw std::invalid_argument("geometric cut: surface triangle " + std::to_string(f) + " names a missing vertex");
+      tri[static_cast<std::size_t>(k)] = surface.vertices.row(v).transpose();
+    }
     const Eigen::Vector3d n = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
     if (!(n.norm() > 0.0) || !n.allFinite()) continue; // a zero-area patch cuts nothing
     for (const auto& v : tri) surface_box.extend(v);
     triangles.push_back(tri);
     normals.push_back(n.normalized());
   }
-  if (triangles.empty()) {
-    report.fragments = m_fragment_count;
-    return report;
-  }
+  if (triangles.empty()) return report;
   auto nearest = [&](const Eigen::Vector3d& p, double& distance) {
     double best = std::numeric_limits<double>::infinity();
     std::size_t which = 0;
@@ -134,10 +143,12 @@ GeometricCutReport CuttableBody::cut(const SweptSurface& surface, const Geometri
     return which;
   };
 
-  // Candidates: tetrahedra whose box, grown by its own size, meets the surface's box.
+  // Candidates: tetrahedra whose box, grown by its own size, meets the surface's box. Every
+  // tetrahedron holding a cross point (within reach <= 1/4 of an edge length of the surface) or a
+  // node on the surface is among them, since its largest box side is at least edge / sqrt(3).
   std::vector<int> candidates;
   double edge_sum = 0.0;
-  for (Eigen::Index t = 0; t < m_mesh.tets.rows(); ++t) {
+  for (Eigen::Index t = 0; t < tet_count; ++t) {
     Eigen::AlignedBox3d box;
     for (int k = 0; k < 4; ++k) box.extend(position(m_mesh.tets(t, k)));
     const double size = box.sizes().maxCoeff();
@@ -147,237 +158,206 @@ GeometricCutReport CuttableBody::cut(const SweptSurface& surface, const Geometri
     candidates.push_back(static_cast<int>(t));
     for (const auto& e : tet_edge) edge_sum += (position(m_mesh.tets(t, e[0])) - position(m_mesh.tets(t, e[1]))).norm();
   }
-  if (candidates.empty()) {
-    report.fragments = m_fragment_count;
-    return report;
-  }
+  if (candidates.empty()) return report;
   const double h = edge_sum / (6.0 * static_cast<double>(candidates.size()));
   const double snap = options.snap_tolerance * h;
 
-  // Signed distance φ of each candidate node: to the plane of its nearest patch; side +1/-1, or
-  // 0 on the surface (within the snap tolerance of it).
+  // Tetrahedra around each node of the candidates (kept up to date while dividing).
+  std::unordered_map<int, std::vector<int>> around;
+  for (int t : candidates)
+    for (int k = 0; k < 4; ++k) around[m_mesh.tets(t, k)].push_back(t);
+
+  // Signed distance φ of each candidate node to the plane of its nearest patch; side +1/-1, or
+  // 0 on the surface (within the snap tolerance of the surface itself).
   std::unordered_map<int, int> side;
   std::unordered_map<int, double> phi;
-  for (int t : candidates)
-    for (int k = 0; k < 4; ++k) {
-      const int g = m_mesh.tets(t, k);
-      if (side.count(g)) continue;
-      const Eigen::Vector3d p = position(g);
-      double distance = 0.0;
-      const std::size_t f = nearest(p, distance);
-      const double value = normals[f].dot(p - triangles[f][0]);
-      phi[g] = value;
-      if (distance < snap) {
-        side[g] = 0;
-        ++report.snapped_nodes;
-      } else {
-        side[g] = value < 0.0 ? -1 : 1;
-      }
+  for (const auto& [g, unused] : around) {
+    (void)unused;
+    const Eigen::Vector3d p = position(g);
+    double distance = 0.0;
+    const std::size_t f = nearest(p, distance);
+    const double value = normals[f].dot(p - triangles[f][0]);
+    phi[g] = value;
+    if (distance < snap) {
+      side[g] = 0;
+      ++report.snapped_nodes;
+    } else {
+      side[g] = value < 0.0 ? -1 : 1;
     }
+  }
 
-  // Cross points on edges whose ends lie on opposite sides: t = φ_a / (φ_a - φ_b).
-  std::unordered_map<std::uint64_t, EdgeCross> cross;
-  auto signs_of = [&](int t, std::array<int, 4>& s) {
-    for (int k = 0; k < 4; ++k) s[static_cast<std::size_t>(k)] = side[m_mesh.tets(t, k)];
-  };
-  std::vector<char> mixed(candidates.size(), 0), divided(candidates.size(), 0);
-  for (std::size_t c = 0; c < candidates.size(); ++c) {
-    std::array<int, 4> s;
-    signs_of(candidates[c], s);
+  // Cross points: on each edge whose ends lie on opposite sides, t = φ_a / (φ_a - φ_b) from the
+  // lower-numbered end a; kept when the point lies on the swept surface itself (within reach x
+  // edge length: the surface is approximated by its linear interpolant) and at least the snap
+  // distance from both ends (no part thinner than that).
+  struct Cross { int a, b; double t; };
+  std::vector<Cross> crosses;
+  std::unordered_set<std::uint64_t> seen;
+  for (int t : candidates)
     for (const auto& e : tet_edge) {
-      if (s[static_cast<std::size_t>(e[0])] * s[static_cast<std::size_t>(e[1])] >= 0) continue;
-      mixed[c] = 1;
-      int a = m_mesh.tets(candidates[c], e[0]), b = m_mesh.tets(candidates[c], e[1]);
+      int a = m_mesh.tets(t, e[0]), b = m_mesh.tets(t, e[1]);
+      if (side[a] * side[b] >= 0) continue;
       if (a > b) std::swap(a, b);
-      const std::uint64_t key = edge_key(a, b);
-      if (cross.count(key)) continue;
-      EdgeCross x;
-      x.t = phi[a] / (phi[a] - phi[b]);
+      if (!seen.insert(edge_key(a, b)).second) continue;
+      const double x = phi[a] / (phi[a] - phi[b]);
       const double length = (position(b) - position(a)).norm();
-      const Eigen::Vector3d point = (1.0 - x.t) * position(a) + x.t * position(b);
+      const Eigen::Vector3d point = (1.0 - x) * position(a) + x * position(b);
       double distance = 0.0;
       nearest(point, distance);
-      x.valid = distance <= options.reach * length && x.t * length >= snap && (1.0 - x.t) * length >= snap;
-      cross[key] = x;
+      if (distance <= options.reach * length && x * length >= snap && (1.0 - x) * length >= snap) crosses.push_back({a, b, x});
     }
-  }
-  // A tetrahedron is divided when all its crossing edges have valid cross points; edges of a
-  // crossed tetrahedron left whole lose theirs (repeat until nothing changes).
-  auto crossing_edges_valid = [&](std::size_t c, bool invalidate) {
-    std::array<int, 4> s;
-    signs_of(candidates[c], s);
-    bool all = true, changed = false;
-    for (const auto& e : tet_edge) {
-      if (s[static_cast<std::size_t>(e[0])] * s[static_cast<std::size_t>(e[1])] >= 0) continue;
-      EdgeCross& x = cross[edge_key(m_mesh.tets(candidates[c], e[0]), m_mesh.tets(candidates[c], e[1]))];
-      if (!x.valid) all = false;
-      else if (invalidate) { x.valid = false; changed = true; }
-    }
-    return invalidate ? changed : all;
-  };
-  for (std::size_t c = 0; c < candidates.size(); ++c) divided[c] = mixed[c] && crossing_edges_valid(c, false);
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (std::size_t c = 0; c < candidates.size(); ++c) {
-      if (!mixed[c]) continue;
-      if (divided[c] && !crossing_edges_valid(c, false)) { divided[c] = 0; changed = true; }
-      if (!divided[c] && crossing_edges_valid(c, true)) changed = true;
-    }
-  }
 
-  // Which side(s) each candidate lies on; nodes on the surface get a second copy when every
-  // tetrahedron around them is divided or on one side, and both sides meet there.
-  std::unordered_map<int, std::array<bool, 3>> around; // zero node -> {whole, has plus, has minus}
-  for (std::size_t c = 0; c < candidates.size(); ++c) {
-    std::array<int, 4> s;
-    signs_of(candidates[c], s);
-    bool plus = false, minus = false;
-    for (int v : s) { plus = plus || v > 0; minus = minus || v < 0; }
-    for (int k = 0; k < 4; ++k) {
-      if (s[static_cast<std::size_t>(k)] != 0) continue;
-      auto [it, fresh] = around.try_emplace(m_mesh.tets(candidates[c], k), std::array<bool, 3>{true, false, false});
-      (void)fresh;
-      if (mixed[c] && !divided[c]) it->second[0] = false;
-      it->second[1] = it->second[1] || plus;
-      it->second[2] = it->second[2] || minus;
+  // Divide (Fig. 8) by bisecting every tetrahedron around each cut edge at its cross point p:
+  // T -> T[a := p] and T[b := p]. Replacing one corner by a point of an incident edge scales the
+  // signed volume by that point's barycentric weight, so both parts keep T's orientation and
+  // their volumes add up to T's: V(T[a := p]) = (1 - t) V(T), V(T[b := p]) = t V(T). The whole
+  // ring of the edge is divided alike, so the mesh stays conforming with no rule to propagate.
+  // Once every crossing edge of a tetrahedron is bisected no part crosses the surface: the parts
+  // on either side are Fig. 8's (a tetrahedron and a prism, two prisms, or with nodes on the
+  // surface a tetrahedron and a pyramid, two tetrahedra), already tetrahedralised. A tetrahedron
+  // where the cut ends keeps its uncut crossing edges whole: it is divided only at the cross
+  // points the surface reaches and stays in one piece (see the opening below).
+  std::vector<char> is_changed(static_cast<std::size_t>(tet_count), 0);
+  std::vector<int> changed_old;
+  std::unordered_set<int> divided_origin;
+  auto origin_of = [&](int t) { return t < tet_count ? t : added_origin[static_cast<std::size_t>(t - tet_count)]; };
+  auto mark_changed = [&](int t) {
+    if (t < tet_count && !is_changed[static_cast<std::size_t>(t)]) {
+      is_changed[static_cast<std::size_t>(t)] = 1;
+      changed_old.push_back(t);
     }
-  }
-  std::vector<Eigen::Vector3d> added;
-  auto add_node = [&](const Eigen::Vector3d& p) {
-    added.push_back(p);
+  };
+  auto erase_from = [](std::vector<int>& list, int t) { list.erase(std::find(list.begin(), list.end(), t)); };
+  for (const Cross& x : crosses) {
+    const int p = static_cast<int>(node_count + static_cast<Eigen::Index>(added_nodes.size()));
+    added_nodes.push_back((1.0 - x.t) * position(x.a) + x.t * position(x.b));
     ++report.new_nodes;
-    return static_cast<int>(node_count + static_cast<Eigen::Index>(added.size()) - 1);
-  };
-  std::unordered_map<int, int> minus_copy;
-  for (const auto& [g, a] : around)
-    if (a[0] && a[1] && a[2]) minus_copy[g] = add_node(position(g));
-  for (auto& [key, x] : cross) {
-    if (!x.valid) continue;
-    const int a = static_cast<int>(key >> 32), b = static_cast<int>(key & 0xffffffffu);
-    const Eigen::Vector3d p = (1.0 - x.t) * position(a) + x.t * position(b);
-    x.plus = add_node(p);
-    x.minus = add_node(p);
-  }
-  auto node_on = [&](int g, int s) {
-    if (s < 0) {
-      const auto it = minus_copy.find(g);
-      if (it != minus_copy.end()) return it->second;
+    side[p] = 0;
+    std::vector<int> ring;
+    for (int t : around[x.a])
+      for (int k = 0; k < 4; ++k)
+        if (corner(t, k) == x.b) ring.push_back(t);
+    std::vector<int>& around_p = around[p];
+    for (int t : ring) {
+      std::array<int, 4> second;
+      for (int k = 0; k < 4; ++k) second[static_cast<std::size_t>(k)] = corner(t, k) == x.b ? p : corner(t, k);
+      for (int k = 0; k < 4; ++k)
+        if (corner(t, k) == x.a) corner(t, k) = p;
+      const int u = static_cast<int>(tet_count + static_cast<Eigen::Index>(added_tets.size()));
+      added_tets.push_back(second);
+      added_origin.push_back(origin_of(t));
+      divided_origin.insert(origin_of(t));
+      mark_changed(t);
+      erase_from(around[x.a], t);
+      for (int g : second) around[g].push_back(u); // a, p and the two others
+      around_p.push_back(t);
     }
-    return g;
-  };
-  auto cross_on = [&](int a, int b, int s) {
-    const EdgeCross& x = cross.at(edge_key(a, b));
-    return s > 0 ? x.plus : x.minus;
-  };
-  m_mesh.nodes.conservativeResize(node_count + static_cast<Eigen::Index>(added.size()), 3);
-  for (std::size_t i = 0; i < added.size(); ++i) m_mesh.nodes.row(node_count + static_cast<Eigen::Index>(i)) = added[i].transpose();
+  }
+  report.cut_tets = static_cast<int>(divided_origin.size());
+  report.new_tets = static_cast<int>(added_tets.size());
 
-  // Divide (Fig. 8) and re-tetrahedralise; re-point whole tetrahedra at their side's node copies.
-  std::vector<std::array<int, 4>> appended;
-  std::vector<int> appended_parent;
-  std::vector<int> changed_slots;
-  report.min_volume_ratio = 1.0;
-  for (std::size_t c = 0; c < candidates.size(); ++c) {
-    const int t = candidates[c];
-    std::array<int, 4> s, n;
-    signs_of(t, s);
-    for (int k = 0; k < 4; ++k) n[static_cast<std::size_t>(k)] = m_mesh.tets(t, k);
-    if (!divided[c]) {
-      int tet_side = 0;
-      for (int v : s) if (v != 0) tet_side = v;
-      bool moved = false;
-      for (int k = 0; k < 4; ++k) {
-        const int g = node_on(n[static_cast<std::size_t>(k)], tet_side);
-        if (g != n[static_cast<std::size_t>(k)]) { m_mesh.tets(t, k) = g; moved = true; }
-      }
-      if (moved) changed_slots.push_back(t);
-      continue;
+  // Opening: a face whose three corners lie on the surface and whose two tetrahedra lie on
+  // opposite sides is cut through. Around each node on the surface, the tetrahedra joined through
+  // faces that are not cut through form connected groups; each group beyond the first gets its
+  // own copy of the node. Where the cut ends inside the body, the tetrahedra left crossing the
+  // surface join the two sides around the front's nodes, so those stay shared: the crack opens
+  // behind the front and closes at it (progressive splitting).
+  auto tet_side = [&](int t) { // +1 / -1 on one side, 0 with no node off the surface, 2 across
+    bool plus = false, minus = false;
+    for (int k = 0; k < 4; ++k) {
+      const auto it = side.find(corner(t, k));
+      const int s = it == side.end() ? 0 : it->second;
+      plus = plus || s > 0;
+      minus = minus || s < 0;
     }
-    ++report.cut_tets;
-    const double parent_volume = signed_tet_volume(position(n[0]), position(n[1]), position(n[2]), position(n[3]));
-    std::vector<std::array<int, 4>> parts;
-    for (int piece_side : {1, -1}) {
-      std::vector<std::vector<int>> faces;
-      std::vector<std::pair<int, int>> segments; // on the cut surface
+    return plus && minus ? 2 : plus ? 1 : minus ? -1 : 0;
+  };
+  auto on_surface = [&](int g) {
+    const auto it = side.find(g);
+    return it != side.end() && it->second == 0;
+  };
+  std::vector<int> surface_nodes;
+  for (const auto& [g, s] : side)
+    if (s == 0) surface_nodes.push_back(g);
+  std::sort(surface_nodes.begin(), surface_nodes.end());
+  for (int z : surface_nodes) {
+    std::vector<int> ring = around[z];
+    if (ring.size() < 2) continue;
+    std::sort(ring.begin(), ring.end());
+    std::vector<int> parent(ring.size());
+    for (std::size_t i = 0; i < ring.size(); ++i) parent[i] = static_cast<int>(i);
+    auto find = [&](int i) {
+      while (parent[static_cast<std::size_t>(i)] != i) i = parent[static_cast<std::size_t>(i)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+      return i;
+    };
+    std::unordered_map<FaceKey, int, FaceKeyHash> first_with;
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const int t = ring[i];
       for (const auto& f : tet_face) {
-        std::vector<int> polygon, on_surface;
-        for (int i = 0; i < 3; ++i) {
-          const int a = f[i], b = f[(i + 1) % 3];
-          const int sa = s[static_cast<std::size_t>(a)], sb = s[static_cast<std::size_t>(b)];
-          if (sa * piece_side >= 0) {
-            polygon.push_back(node_on(n[static_cast<std::size_t>(a)], piece_side));
-            if (sa == 0) on_surface.push_back(polygon.back());
-          }
-          if (sa * sb < 0) {
-            polygon.push_back(cross_on(n[static_cast<std::size_t>(a)], n[static_cast<std::size_t>(b)], piece_side));
-            on_surface.push_back(polygon.back());
-          }
-        }
-        if (on_surface.size() == 2) segments.emplace_back(on_surface[0], on_surface[1]);
-        if (polygon.size() >= 3 && on_surface.size() < polygon.size()) faces.push_back(polygon);
-      }
-      // The cut face: chain the on-surface segments into one polygon.
-      if (segments.size() >= 3) {
-        std::vector<int> polygon{segments[0].first, segments[0].second};
-        std::vector<char> used(segments.size(), 0);
-        used[0] = 1;
-        for (std::size_t step = 1; step < segments.size(); ++step)
-          for (std::size_t i = 0; i < segments.size(); ++i) {
-            if (used[i]) continue;
-            const int last = polygon.back();
-            if (segments[i].first == last || segments[i].second == last) {
-              const int next = segments[i].first == last ? segments[i].second : segments[i].first;
-              used[i] = 1;
-              if (next != polygon.front()) polygon.push_back(next);
-              break;
-            }
-          }
-        if (polygon.size() >= 3) faces.push_back(polygon);
-      }
-      int apex = std::numeric_limits<int>::max();
-      for (const auto& f : faces) for (int g : f) apex = std::min(apex, g);
-      for (auto f : faces) {
-        if (std::find(f.begin(), f.end(), apex) != f.end()) continue;
-        std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
-        for (std::size_t i = 1; i + 1 < f.size(); ++i) {
-          std::array<int, 4> tet{apex, f[0], f[i], f[i + 1]};
-          double v = signed_tet_volume(position(tet[0]), position(tet[1]), position(tet[2]), position(tet[3]));
-          if (v < 0.0) { std::swap(tet[2], tet[3]); v = -v; }
-          report.min_volume_ratio = std::min(report.min_volume_ratio, v / parent_volume);
-          parts.push_back(tet);
-        }
+        const int a = corner(t, f[0]), b = corner(t, f[1]), c = corner(t, f[2]);
+        if (a != z && b != z && c != z) continue;
+        const auto [it, fresh] = first_with.try_emplace(face_key(a, b, c), static_cast<int>(i));
+        if (fresh) continue;
+        const int j = it->second;
+        const int si = tet_side(t), sj = tet_side(ring[static_cast<std::size_t>(j)]);
+        const bool cut_through = on_surface(a) && on_surface(b) && on_surface(c) && si * sj == -1;
+        if (!cut_through) parent[static_cast<std::size_t>(find(static_cast<int>(i)))] = find(j);
       }
     }
-    for (int k = 0; k < 4; ++k) m_mesh.tets(t, k) = parts[0][static_cast<std::size_t>(k)];
-    changed_slots.push_back(t);
-    for (std::size_t i = 1; i < parts.size(); ++i) {
-      appended.push_back(parts[i]);
-      appended_parent.push_back(t);
+    std::unordered_map<int, int> copy_of_group;
+    const int kept = find(0);
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const int group = find(static_cast<int>(i));
+      if (group == kept) continue;
+      auto [it, fresh] = copy_of_group.try_emplace(group, -1);
+      if (fresh) {
+        it->second = static_cast<int>(node_count + static_cast<Eigen::Index>(added_nodes.size()));
+        added_nodes.push_back(position(z));
+        side[it->second] = 0;
+        ++report.new_nodes;
+      }
+      const int t = ring[i];
+      for (int k = 0; k < 4; ++k)
+        if (corner(t, k) == z) corner(t, k) = it->second;
+      mark_changed(t);
+      erase_from(around[z], t);
+      around[it->second].push_back(t);
     }
   }
-  const Eigen::Index old_count = m_mesh.tets.rows();
-  m_mesh.tets.conservativeResize(old_count + static_cast<Eigen::Index>(appended.size()), 4);
+
+  // Smallest part against its original tetrahedron.
+  std::unordered_map<int, double> origin_volume;
+  for (int t : divided_origin) origin_volume[t] = 0.0;
+  auto all_parts = changed_old;
+  for (std::size_t i = 0; i < added_tets.size(); ++i) all_parts.push_back(static_cast<int>(tet_count + static_cast<Eigen::Index>(i)));
+  for (int t : all_parts)
+    if (const auto it = origin_volume.find(origin_of(t)); it != origin_volume.end()) it->second += volume_of(t);
+  for (int t : all_parts)
+    if (const auto it = origin_volume.find(origin_of(t)); it != origin_volume.end())
+      report.min_volume_ratio = std::min(report.min_volume_ratio, volume_of(t) / it->second);
+
+  // Write back: nodes and tetrahedra appended, volume groups extended by the origin's parts.
+  m_mesh.nodes.conservativeResize(node_count + static_cast<Eigen::Index>(added_nodes.size()), 3);
+  for (std::size_t i = 0; i < added_nodes.size(); ++i) m_mesh.nodes.row(node_count + static_cast<Eigen::Index>(i)) = added_nodes[i].transpose();
+  m_mesh.tets.conservativeResize(tet_count + static_cast<Eigen::Index>(added_tets.size()), 4);
   m_adjacency.conservativeResize(m_mesh.tets.rows(), 4);
-  for (std::size_t i = 0; i < appended.size(); ++i) {
-    const Eigen::Index row = old_count + static_cast<Eigen::Index>(i);
-    for (int k = 0; k < 4; ++k) m_mesh.tets(row, k) = appended[i][static_cast<std::size_t>(k)];
+  for (std::size_t i = 0; i < added_tets.size(); ++i) {
+    const Eigen::Index row = tet_count + static_cast<Eigen::Index>(i);
+    for (int k = 0; k < 4; ++k) m_mesh.tets(row, k) = added_tets[i][static_cast<std::size_t>(k)];
     m_adjacency.row(row).setConstant(-1);
   }
-  report.new_tets = static_cast<int>(appended.size());
   for (VolumeGroup& group : m_mesh.volume_groups)
-    for (std::size_t i = 0; i < appended.size(); ++i)
-      if (std::binary_search(group.tets.begin(), group.tets.end(), appended_parent[i]))
-        group.tets.push_back(static_cast<int>(old_count + static_cast<Eigen::Index>(i)));
+    for (std::size_t i = 0; i < added_tets.size(); ++i)
+      if (std::binary_search(group.tets.begin(), group.tets.end(), added_origin[i])) // stays sorted: appended rows grow
+        group.tets.push_back(static_cast<int>(tet_count + static_cast<Eigen::Index>(i)));
 
   // Neighbour relation, updated locally: the changed and new tetrahedra and their old neighbours.
-  std::unordered_set<int> changed(changed_slots.begin(), changed_slots.end());
-  std::vector<int> affected = changed_slots;
-  for (Eigen::Index r = old_count; r < m_mesh.tets.rows(); ++r) affected.push_back(static_cast<int>(r));
+  std::vector<int> affected = all_parts;
   std::vector<int> neighbours;
-  for (int t : changed_slots)
+  for (int t : changed_old)
     for (int k = 0; k < 4; ++k) {
       const int u = m_adjacency(t, k);
-      if (u >= 0 && !changed.count(u)) neighbours.push_back(u);
+      if (u >= 0 && !is_changed[static_cast<std::size_t>(u)]) neighbours.push_back(u);
     }
   std::sort(neighbours.begin(), neighbours.end());
   neighbours.erase(std::unique(neighbours.begin(), neighbours.end()), neighbours.end());
@@ -395,11 +375,12 @@ GeometricCutReport CuttableBody::cut(const SweptSurface& surface, const Geometri
     const std::array<int, 2>& pair = faces.at(key_of(t, k));
     return pair[0] == t ? pair[1] : pair[0];
   };
+  auto changed = [&](int u) { return u >= tet_count || is_changed[static_cast<std::size_t>(u)]; };
   for (int t : affected)
     for (int k = 0; k < 4; ++k) m_adjacency(t, k) = across(t, k);
   for (int t : neighbours)
     for (int k = 0; k < 4; ++k)
-      if (const int u = m_adjacency(t, k); u >= 0 && changed.count(u)) m_adjacency(t, k) = across(t, k);
+      if (const int u = m_adjacency(t, k); u >= 0 && changed(u)) m_adjacency(t, k) = across(t, k);
 
   label_fragments();
   report.fragments = m_fragment_count;

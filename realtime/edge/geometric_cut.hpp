@@ -26,9 +26,9 @@ struct GeometricCutOptions {
 
 /// What one cut did.
 struct GeometricCutReport {
-  int cut_tets = 0;        ///< tetrahedra divided
+  int cut_tets = 0;        ///< tetrahedra (as before the cut) divided
   int new_tets = 0;        ///< tetrahedra added (parts beyond the first of each divided one)
-  int new_nodes = 0;       ///< cross points (two copies each, one per side) and node copies
+  int new_nodes = 0;       ///< cross points and the copies made when the crack opens
   int snapped_nodes = 0;   ///< nodes put on the surface by snap_tolerance
   int fragments = 0;       ///< connected parts of the object after the cut
   double min_volume_ratio = 0.0; ///< smallest (part volume / parent volume) over the parts made
@@ -41,19 +41,26 @@ public:
   /// Takes the mesh (every tetrahedron positively oriented) and builds its adjacency.
   explicit CuttableBody(TetMesh mesh);
 
-  /// Cuts along `surface`: every tetrahedron edge crossing the surface gets a cross point, where
-  /// the linear interpolant of the nodes' signed distances φ to the surface vanishes
-  /// (t = φ_a / (φ_a - φ_b)); nodes with |φ| below the snap tolerance are on the surface. A
-  /// tetrahedron is divided when every one of its edges whose ends lie on opposite sides has a
-  /// cross point on the surface (Fig. 8: one node apart gives a tetrahedron and a prism, two
-  /// apart two prisms, with nodes on the surface a tetrahedron and a pyramid, or two
-  /// tetrahedra); a tetrahedron the surface only partly crosses (where the cut ends) is left
-  /// whole, and so are its edges, so the mesh stays conforming. That rule propagates through
-  /// shared edges: a surface that ends inside the body (a partial cut, no separation) divides
-  /// nothing; only cuts that run through the body are applied. Each part is a convex polyhedron,
-  /// split into tetrahedra by coning from its lowest-numbered node over its faces, each face
-  /// split from its own lowest-numbered node, so that shared faces split alike. Cross points and
-  /// surface nodes whose surroundings are all divided get one copy per side: the sides separate.
+  /// Cuts along `surface` (paper 000 §3.2, Fig. 9). Every node near the surface gets the signed
+  /// distance φ to the plane of its nearest patch; nodes within the snap tolerance of the surface
+  /// are on it. Each tetrahedron edge whose ends lie on opposite sides gets a cross point where
+  /// the linear interpolant of φ vanishes (t = φ_a / (φ_a - φ_b)) when that point lies on the
+  /// swept surface (within `reach` x edge length) and at least the snap distance from both ends.
+  /// Division: every tetrahedron around such an edge is bisected at its cross point
+  /// (T -> T[a := p], T[b := p]: both keep T's orientation, volumes (1 - t) V and t V), so the
+  /// mesh stays conforming without any rule that propagates; a tetrahedron whose crossing edges
+  /// are all bisected ends as Fig. 8's two parts (tetrahedron + prism, two prisms, or with nodes
+  /// on the surface tetrahedron + pyramid, two tetrahedra), already tetrahedralised. Opening: a
+  /// face with its three corners on the surface between tetrahedra on opposite sides is cut
+  /// through; around each surface node the tetrahedra joined through faces not cut through form
+  /// groups, and each group beyond the first gets its own copy of the node.
+  /// Cuts that end inside the body (progressive splitting): tetrahedra the surface only partly
+  /// crosses are bisected at the cross points it reaches and keep their other crossing edges
+  /// whole; they still join both sides around the front's nodes, so the crack is open behind the
+  /// front and closed at it, and a later cut that continues the surface opens it further.
+  /// Nodes and tetrahedra are only appended or re-pointed (original node indices and positions
+  /// stay; surface groups keep their original faces); volume groups take the parts of their
+  /// tetrahedra.
   GeometricCutReport cut(const SweptSurface& surface, const GeometricCutOptions& options = {});
 
   [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }

@@ -45,6 +45,22 @@ Session read_session(const std::filesystem::path& file) {
       fail(std::string("column ") + column + ": expected a finite number, found \"" + field + "\"");
     return v;
   };
+  // The model's own force may be NaN or Inf (the safety layer replaced it, status safety_non_finite):
+  // the file records what the model returned, so these columns take any number strtod reads.
+  auto model_number_at = [&](const std::string& field) {
+    char* end = nullptr;
+    const double v = std::strtod(field.c_str(), &end);
+    if (field.empty() || *end != '\0') fail("column model_f: expected a number, found \"" + field + "\"");
+    return v;
+  };
+  // Counts and bit sets (tick, buttons, status): a whole number in [0, limit), checked before the
+  // conversion (a negative or too large double converted to an unsigned integer is undefined).
+  auto whole_at = [&](const std::string& field, const char* column, double limit) {
+    const double v = number_at(field, column);
+    if (!(v >= 0.0 && v < limit) || v != std::floor(v))
+      fail(std::string("column ") + column + ": expected a whole number from 0, found \"" + field + "\"");
+    return v;
+  };
 
   const std::vector<std::string> columns = split(session_csv_header, ',');
   TickRecord current;
@@ -79,7 +95,7 @@ Session read_session(const std::filesystem::path& file) {
     const std::vector<std::string> f = split(line, ',');
     if (f.size() != columns.size())
       fail("expected " + std::to_string(columns.size()) + " columns, found " + std::to_string(f.size()));
-    const auto tick = static_cast<std::uint64_t>(number_at(f[0], "tick"));
+    const auto tick = static_cast<std::uint64_t>(whole_at(f[0], "tick", 0x1p64));
     int tool = -1;
     for (std::size_t k = 0; k < session.header.tools.size(); ++k)
       if (session.header.tools[k] == f[2]) tool = static_cast<int>(k);
@@ -103,17 +119,17 @@ Session read_session(const std::filesystem::path& file) {
     for (int c = 0; c < 3; ++c) {
       k.position[c] = number_at(f[3 + static_cast<std::size_t>(c)], "p");
       k.velocity[c] = number_at(f[6 + static_cast<std::size_t>(c)], "v");
-      k.model_force[c] = number_at(f[14 + static_cast<std::size_t>(c)], "model_f");
+      k.model_force[c] = model_number_at(f[14 + static_cast<std::size_t>(c)]);
       k.force[c] = number_at(f[17 + static_cast<std::size_t>(c)], "f");
     }
     for (int c = 0; c < 4; ++c) k.orientation[c] = number_at(f[9 + static_cast<std::size_t>(c)], "q");
-    k.buttons = static_cast<std::uint32_t>(number_at(f[13], "buttons"));
+    k.buttons = static_cast<std::uint32_t>(whole_at(f[13], "buttons", 0x1p32));
     const auto mode = interaction_mode_from_string(f[20]);
     if (!mode) fail("unknown mode \"" + f[20] + "\"");
     k.mode = *mode;
     k.crack_extent = number_at(f[21], "crack_extent");
     k.link_age = number_at(f[24], "link_age_s");
-    k.status = static_cast<std::uint32_t>(number_at(f[25], "status"));
+    k.status = static_cast<std::uint32_t>(whole_at(f[25], "status", 0x1p32));
     k.injected = number_at(f[26], "injected_j");
     ++current.tools;
   }

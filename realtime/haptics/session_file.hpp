@@ -32,7 +32,7 @@ struct ToolTick {
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();     ///< [m/s] as given to the model
   Eigen::Vector4d orientation{1.0, 0.0, 0.0, 0.0};        ///< device quaternion (w, x, y, z)
   std::uint32_t buttons = 0;
-  Eigen::Vector3d model_force = Eigen::Vector3d::Zero();  ///< the model's force [N] (before safety)
+  Eigen::Vector3d model_force = Eigen::Vector3d::Zero();  ///< the model's force [N] (before safety; NaN/Inf if the model returned one)
   Eigen::Vector3d force = Eigen::Vector3d::Zero();        ///< the commanded force [N] (after safety)
   InteractionMode mode = InteractionMode::no_contact;
   double crack_extent = 0.0;  ///< [m]

@@ -1,74 +1,238 @@
 #include "realtime/springs/network_system.hpp"
 
+#include <cholmod.h>
+#include <dlfcn.h>
+
 #include <algorithm>
+#include <cstring>
+#include <mutex>
+#include <stdexcept>
+#include <string>
 
 namespace kerf {
 
+namespace {
+
+// CHOLMOD's numeric supernodal factorisation takes one temporary per call from SuiteSparse's
+// allocator (the dense update block of L->maxcsize entries, cholmod_super_numeric). To keep
+// `factorize` allocation-free, SuiteSparse's allocator hooks are wrapped once: while a thread
+// has a workspace lease armed (only inside NetworkSystem::factorize), allocations on that thread
+// are carved out of the lease's buffer; everywhere else, and on every other thread, the hooks
+// pass straight through to the allocator that was installed before.
+struct WorkspaceLease {
+  char* begin = nullptr;
+  std::size_t size = 0;
+  std::size_t used = 0;
+  int live = 0; ///< blocks handed out and not yet freed
+  [[nodiscard]] bool holds(const void* p) const {
+    const char* c = static_cast<const char*>(p);
+    return c >= begin && c < begin + size;
+  }
+};
+thread_local WorkspaceLease* t_lease = nullptr;
+
+struct Hooks {
+  void* (*malloc_func)(std::size_t);
+  void* (*calloc_func)(std::size_t, std::size_t);
+  void* (*realloc_func)(void*, std::size_t);
+  void (*free_func)(void*);
+};
+Hooks g_previous{};
+
+void* lease_take(std::size_t bytes) noexcept {
+  WorkspaceLease* lease = t_lease;
+  if (!lease) return nullptr;
+  const std::size_t start = (lease->used + 63) & ~static_cast<std::size_t>(63);
+  if (start + bytes > lease->size) return nullptr;
+  lease->used = start + bytes;
+  ++lease->live;
+  return lease->begin + start;
+}
+void* hook_malloc(std::size_t bytes) {
+  if (void* p = lease_take(bytes)) return p;
+  return g_previous.malloc_func(bytes);
+}
+void* hook_calloc(std::size_t count, std::size_t size) {
+  if (void* p = lease_take(count * size)) return std::memset(p, 0, count * size);
+  return g_previous.calloc_func(count, size);
+}
+void* hook_realloc(void* p, std::size_t bytes) {
+  if (t_lease && p && t_lease->holds(p)) { // move the block out of the lease (never on the hot path)
+    void* q = g_previous.malloc_func(bytes);
+    if (q) std::memcpy(q, p, std::min(bytes, static_cast<std::size_t>(t_lease->begin + t_lease->size - static_cast<char*>(p))));
+    --t_lease->live;
+    return q;
+  }
+  return g_previous.realloc_func(p, bytes);
+}
+void hook_free(void* p) {
+  if (t_lease && p && t_lease->holds(p)) {
+    --t_lease->live;
+    return;
+  }
+  g_previous.free_func(p);
+}
+
+// OpenBLAS (Debian's default BLAS, openblas-pthread) fans large BLAS calls out to its thread
+// pool, which allocates per call and puts other threads on the servo's critical path. Around the
+// factorisation its thread count is set to one and then restored (the pool is not resized, so
+// that allocates nothing either). Looked up at run time: other BLAS builds have no such call.
+int (*g_blas_get_threads)() = nullptr;
+void (*g_blas_set_threads)(int) = nullptr;
+
+void install_lease_hooks() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    g_blas_get_threads = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+    g_blas_set_threads = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+    if (!g_blas_get_threads || !g_blas_set_threads) g_blas_get_threads = nullptr, g_blas_set_threads = nullptr;
+    g_previous = {SuiteSparse_config.malloc_func, SuiteSparse_config.calloc_func, SuiteSparse_config.realloc_func,
+                  SuiteSparse_config.free_func};
+    SuiteSparse_config.malloc_func = hook_malloc;
+    SuiteSparse_config.calloc_func = hook_calloc;
+    SuiteSparse_config.realloc_func = hook_realloc;
+    SuiteSparse_config.free_func = hook_free;
+  });
+}
+
+/// Arms a lease on this thread for the scope.
+class ArmedLease {
+public:
+  ArmedLease(std::vector<double>& buffer, WorkspaceLease& lease) : m_lease(lease) {
+    lease = WorkspaceLease{reinterpret_cast<char*>(buffer.data()), buffer.size() * sizeof(double), 0, 0};
+    t_lease = &lease;
+  }
+  ~ArmedLease() { t_lease = nullptr; }
+  ArmedLease(const ArmedLease&) = delete;
+  ArmedLease& operator=(const ArmedLease&) = delete;
+
+private:
+  WorkspaceLease& m_lease;
+};
+
+} // namespace
+
+NetworkSystem::NetworkSystem() {
+  install_lease_hooks();
+  m_common = new cholmod_common;
+  cholmod_start(m_common);
+  m_common->supernodal = CHOLMOD_SUPERNODAL;
+  m_common->print = 0;
+}
+
+NetworkSystem::NetworkSystem(const SpringNetwork& net) : NetworkSystem() { rebuild(net); }
+
+NetworkSystem::~NetworkSystem() {
+  release();
+  cholmod_finish(m_common);
+  delete m_common;
+}
+
+void NetworkSystem::release() noexcept {
+  if (m_factor) cholmod_free_factor(&m_factor, m_common);
+  for (cholmod_dense** d : {&m_rhs, &m_solution, &m_work_y, &m_work_e})
+    if (*d) cholmod_free_dense(d, m_common);
+}
+
+double NetworkSystem::factor_entries() const {
+  if (!m_factor) return 0.0;
+  return m_factor->is_super ? static_cast<double>(m_factor->xsize) : static_cast<double>(m_factor->nzmax);
+}
+
 void NetworkSystem::rebuild(const SpringNetwork& net) {
+  release();
+  m_factorized = false;
   // Free dofs in node order first.
   std::vector<int> natural(static_cast<std::size_t>(3 * net.node_capacity()), -1);
   int n = 0;
   for (int p = 0; p < net.node_count; ++p)
     for (int i = 0; i < 3; ++i)
       if (!(net.constraint[static_cast<std::size_t>(p)] & (1u << i))) natural[static_cast<std::size_t>(3 * p + i)] = n++;
-  // Pattern of all cell couplings (both triangles) for the ordering.
-  std::vector<Eigen::Triplet<double, int>> triplets;
-  triplets.reserve(static_cast<std::size_t>(net.cell_count()) * 576);
-  for (const auto& nodes : net.cell_nodes)
-    for (int a = 0; a < 24; ++a) {
-      const int r = natural[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(a / 3)] + a % 3)];
-      if (r < 0) continue;
-      for (int b = 0; b < 24; ++b) {
-        const int c = natural[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(b / 3)] + b % 3)];
-        if (c >= 0) triplets.emplace_back(r, c, 1.0);
+  const auto dof = [&net](const std::vector<int>& map, int cell, int a) {
+    return map[static_cast<std::size_t>(3 * net.cell_nodes[static_cast<std::size_t>(cell)][static_cast<std::size_t>(a / 3)] + a % 3)];
+  };
+  const auto lower_pattern = [&](const std::vector<int>& map) {
+    std::vector<Eigen::Triplet<double, int>> triplets;
+    triplets.reserve(static_cast<std::size_t>(net.cell_count()) * 300);
+    for (int cell = 0; cell < net.cell_count(); ++cell)
+      for (int a = 0; a < 24; ++a) {
+        const int r = dof(map, cell, a);
+        if (r < 0) continue;
+        for (int b = 0; b < 24; ++b)
+          if (const int c = dof(map, cell, b); c >= 0 && r >= c) triplets.emplace_back(r, c, 1.0);
       }
-    }
-  Matrix full(n, n);
-  full.setFromTriplets(triplets.begin(), triplets.end());
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> new_to_old;
-  Eigen::AMDOrdering<int> amd;
-  amd(full, new_to_old);
-  std::vector<int> old_to_new(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k)
-    old_to_new[static_cast<std::size_t>(new_to_old.size() > 0 ? new_to_old.indices()[k] : k)] = k;
+    Matrix m(n, n);
+    m.setFromTriplets(triplets.begin(), triplets.end());
+    m.makeCompressed();
+    return m;
+  };
+  m_matrix = lower_pattern(natural);
+  m_rhs = cholmod_allocate_dense(static_cast<std::size_t>(n), 1, static_cast<std::size_t>(n), CHOLMOD_REAL, m_common);
+  if (n == 0) {
+    m_dof_of.assign(natural.size(), -1);
+    m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
+    m_diagonal.clear();
+    return;
+  }
+
+  // Ordering and symbolic analysis by CHOLMOD on the natural pattern.
+  const auto view = [](Matrix& m, int stype) {
+    cholmod_sparse s{};
+    s.nrow = s.ncol = static_cast<std::size_t>(m.rows());
+    s.nzmax = static_cast<std::size_t>(m.nonZeros());
+    s.p = m.outerIndexPtr();
+    s.i = m.innerIndexPtr();
+    s.x = m.valuePtr();
+    s.stype = stype;
+    s.itype = CHOLMOD_INT;
+    s.xtype = CHOLMOD_REAL;
+    s.dtype = CHOLMOD_DOUBLE;
+    s.sorted = 1;
+    s.packed = 1;
+    return s;
+  };
+  cholmod_sparse pattern = view(m_matrix, -1);
+  m_factor = cholmod_analyze(&pattern, m_common);
+  if (!m_factor || m_common->status < CHOLMOD_OK)
+    throw std::runtime_error("NetworkSystem: CHOLMOD analysis failed (status " + std::to_string(m_common->status) + ")");
+  // Numeric storage of L, and Common's workspace, allocated now rather than on the first factorisation.
+  cholmod_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, m_factor, m_common);
+  cholmod_allocate_work(static_cast<std::size_t>(n), 2 * static_cast<std::size_t>(n) + 5 * m_factor->nsuper, 0, m_common);
+  if (m_common->status < CHOLMOD_OK) throw std::runtime_error("NetworkSystem: CHOLMOD workspace allocation failed");
+  const int* perm = static_cast<const int*>(m_factor->Perm); // perm[new] = natural
+  std::vector<int> new_of_natural(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) new_of_natural[static_cast<std::size_t>(perm[k])] = k;
   m_dof_of.assign(natural.size(), -1);
   for (std::size_t k = 0; k < natural.size(); ++k)
-    if (natural[k] >= 0) m_dof_of[k] = old_to_new[static_cast<std::size_t>(natural[k])];
+    if (natural[k] >= 0) m_dof_of[k] = new_of_natural[static_cast<std::size_t>(natural[k])];
 
-  // Upper-triangular pattern in the new order.
-  triplets.clear();
-  for (const auto& nodes : net.cell_nodes)
-    for (int a = 0; a < 24; ++a) {
-      const int r = m_dof_of[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(a / 3)] + a % 3)];
-      if (r < 0) continue;
-      for (int b = 0; b < 24; ++b) {
-        const int c = m_dof_of[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(b / 3)] + b % 3)];
-        if (c >= r) triplets.emplace_back(r, c, 1.0);
-      }
-    }
-  m_matrix.resize(n, n);
-  m_matrix.setFromTriplets(triplets.begin(), triplets.end());
-  m_matrix.makeCompressed();
+  // Lower-triangular pattern in the factor's order, and each cell entry's place in it.
+  m_matrix = lower_pattern(m_dof_of);
   const auto index_of = [this](int r, int c) {
     const int* rows = m_matrix.innerIndexPtr();
     const int begin = m_matrix.outerIndexPtr()[c], end = m_matrix.outerIndexPtr()[c + 1];
     return static_cast<int>(std::lower_bound(rows + begin, rows + end, r) - rows);
   };
   m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
-  for (int cell = 0; cell < net.cell_count(); ++cell) {
-    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(cell)];
+  for (int cell = 0; cell < net.cell_count(); ++cell)
     for (int a = 0; a < 24; ++a) {
-      const int r = m_dof_of[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(a / 3)] + a % 3)];
+      const int r = dof(m_dof_of, cell, a);
       if (r < 0) continue;
-      for (int b = 0; b < 24; ++b) {
-        const int c = m_dof_of[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(b / 3)] + b % 3)];
-        if (c >= r) m_entry[static_cast<std::size_t>(cell) * 576 + static_cast<std::size_t>(24 * a + b)] = index_of(r, c);
-      }
+      for (int b = 0; b < 24; ++b)
+        if (const int c = dof(m_dof_of, cell, b); c >= 0 && r >= c)
+          m_entry[static_cast<std::size_t>(cell) * 576 + static_cast<std::size_t>(24 * a + b)] = index_of(r, c);
     }
-  }
   m_diagonal.assign(static_cast<std::size_t>(n), -1);
   for (int k = 0; k < n; ++k) m_diagonal[static_cast<std::size_t>(k)] = index_of(k, k);
-  m_ldlt.analyzePattern(m_matrix);
+
+  // The lease for cholmod_super_numeric's temporary: its cholmod_dense header and L->maxcsize
+  // entries, with room for alignment.
+  m_update_buffer.assign(m_factor->maxcsize + (sizeof(cholmod_dense) + 256) / sizeof(double) + 1, 0.0);
+  // One factorisation and solve of the mass matrix sizes the solve's kept workspaces.
+  assemble(net, net.rest, 1.0, 0.0);
+  if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
+  Eigen::VectorXd ones = Eigen::VectorXd::Ones(n), out(n);
+  solve(ones, out);
   m_factorized = false;
 }
 
@@ -78,15 +242,16 @@ void NetworkSystem::assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x
   std::fill(values, values + m_matrix.nonZeros(), 0.0);
   Eigen::Matrix<double, 3, 8> xc;
   Eigen::Matrix<double, 24, 24> K;
-  for (int cell = 0; cell < net.cell_count(); ++cell) {
-    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(cell)];
-    for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
-    cell_stiffness_matrix(net, cell, xc, K);
-    const int* entry = m_entry.data() + static_cast<std::size_t>(cell) * 576;
-    for (int a = 0; a < 24; ++a)
-      for (int b = 0; b < 24; ++b)
-        if (const int e = entry[24 * a + b]; e >= 0) values[e] += stiffness_weight * K(a, b);
-  }
+  if (stiffness_weight != 0.0)
+    for (int cell = 0; cell < net.cell_count(); ++cell) {
+      const auto& nodes = net.cell_nodes[static_cast<std::size_t>(cell)];
+      for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
+      cell_stiffness_matrix(net, cell, xc, K);
+      const int* entry = m_entry.data() + static_cast<std::size_t>(cell) * 576;
+      for (int a = 0; a < 24; ++a)
+        for (int b = 0; b < 24; ++b)
+          if (const int e = entry[24 * a + b]; e >= 0) values[e] += stiffness_weight * K(a, b);
+    }
   for (int p = 0; p < net.node_count; ++p)
     for (int i = 0; i < 3; ++i)
       if (const int d = m_dof_of[static_cast<std::size_t>(3 * p + i)]; d >= 0)
@@ -94,17 +259,45 @@ void NetworkSystem::assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x
 }
 
 bool NetworkSystem::factorize() noexcept {
-  m_ldlt.factorize_in_place(m_matrix);
-  m_factorized = m_ldlt.info() == Eigen::Success;
+  if (!m_factor) return m_factorized = dof_count() == 0;
+  cholmod_sparse a{};
+  a.nrow = a.ncol = static_cast<std::size_t>(m_matrix.rows());
+  a.nzmax = static_cast<std::size_t>(m_matrix.nonZeros());
+  a.p = m_matrix.outerIndexPtr();
+  a.i = m_matrix.innerIndexPtr();
+  a.x = m_matrix.valuePtr();
+  a.stype = -1;
+  a.itype = CHOLMOD_INT;
+  a.xtype = CHOLMOD_REAL;
+  a.dtype = CHOLMOD_DOUBLE;
+  a.sorted = 1;
+  a.packed = 1;
+  double beta[2] = {0.0, 0.0};
+  WorkspaceLease lease;
+  const int blas_threads = g_blas_get_threads ? g_blas_get_threads() : 1;
+  if (blas_threads > 1) g_blas_set_threads(1);
+  {
+    const ArmedLease armed(m_update_buffer, lease);
+    // LLᵀ = A, A already in the factor's order (cholmod_factorize would first build A(p,p)).
+    cholmod_super_numeric(&a, nullptr, beta, m_factor, m_common);
+  }
+  if (blas_threads > 1) g_blas_set_threads(blas_threads);
+  m_factorized = m_common->status == CHOLMOD_OK && lease.live == 0;
   return m_factorized;
 }
 
-void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) const noexcept {
-  out = rhs;
-  // L D Lᵀ out = rhs (no permutation: the matrix is assembled in the factor's order)
-  m_ldlt.matrixL().solveInPlace(out);
-  out.array() /= m_ldlt.diagonal().array();
-  m_ldlt.matrixU().solveInPlace(out);
+void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept {
+  const int n = dof_count();
+  if (n == 0) return;
+  double* b = static_cast<double*>(m_rhs->x);
+  std::copy(rhs.data(), rhs.data() + n, b);
+  // L Lᵀ out = rhs: the system is in the factor's order already, so no permutation (CHOLMOD_LDLt).
+  const int blas_threads = g_blas_get_threads ? g_blas_get_threads() : 1;
+  if (blas_threads > 1) g_blas_set_threads(1);
+  cholmod_solve2(CHOLMOD_LDLt, m_factor, m_rhs, nullptr, &m_solution, nullptr, &m_work_y, &m_work_e, m_common);
+  if (blas_threads > 1) g_blas_set_threads(blas_threads);
+  const double* x = static_cast<const double*>(m_solution->x);
+  std::copy(x, x + n, out.data());
 }
 
 } // namespace kerf

@@ -5,9 +5,10 @@
 
 namespace kerf {
 
-NewtonStepper::NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations)
-    : m_mode(mode), m_max_iterations(max_iterations) {
+NewtonStepper::NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations, double relative_tolerance)
+    : m_mode(mode), m_max_iterations(max_iterations), m_tolerance_ratio(relative_tolerance) {
   if (max_iterations < 1) throw std::invalid_argument("NewtonStepper: max_iterations must be >= 1");
+  if (!(relative_tolerance > 0.0)) throw std::invalid_argument("NewtonStepper: the relative tolerance must be > 0");
   rebuild(net);
 }
 
@@ -18,6 +19,7 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_v0.setZero(3, cap);
   m_f.setZero(3, cap);
   m_zero.setZero(3, cap);
+  m_x_before.setZero(3, cap);
   m_r.setZero(m_system.dof_count());
   m_dx.setZero(m_system.dof_count());
   m_factor_dt = -1.0;
@@ -69,24 +71,48 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
     for (int p = 0; p < n; ++p)
       for (int i = 0; i < 3; ++i)
         if (dof[static_cast<std::size_t>(3 * p + i)] >= 0) x(i, p) += dt * v(i, p);
+  // `fresh`: the kept factorisation was computed at the current iterate.
+  bool fresh = false;
   if (m_mode == Mode::implicit_euler ? m_factor_dt != dt : m_factor_dt < 0.0) {
     if (!refactor(net, x, dt)) return report;
     ++report.factorisations;
+    fresh = true;
   }
-  const double tolerance = 1e-9 * net.stiffness.edge * net.block.cell_size;
+  const double tolerance = m_tolerance_ratio * net.stiffness.edge * net.block.cell_size;
   double norm = residual(net, x, v, dt);
   double previous = INFINITY;
-  for (; report.iterations < m_max_iterations && norm > tolerance; ++report.iterations) {
-    if (norm > 0.25 * previous) { // the kept factorisation no longer converges fast: refresh it
+  while (report.iterations < m_max_iterations && norm > tolerance) {
+    if (!fresh && norm > 0.25 * previous) { // the kept factorisation no longer converges fast: refresh it
       if (!refactor(net, x, dt)) break;
       ++report.factorisations;
+      fresh = true;
     }
     m_system.solve(m_r, m_dx);
-    for (int p = 0; p < n; ++p)
-      for (int i = 0; i < 3; ++i)
-        if (const int d = dof[static_cast<std::size_t>(3 * p + i)]; d >= 0) x(i, p) -= m_dx[d];
+    ++report.iterations;
+    m_x_before.leftCols(n) = x.leftCols(n);
+    // Backtracking: x ← x − α Δx with α = 1, 1/2, …, 1/32, the first that lowers the residual.
+    double trial = INFINITY;
+    double alpha = 1.0;
+    for (int halving = 0; halving <= 5; ++halving, alpha *= 0.5) {
+      for (int p = 0; p < n; ++p)
+        for (int i = 0; i < 3; ++i)
+          if (const int d = dof[static_cast<std::size_t>(3 * p + i)]; d >= 0) x(i, p) = m_x_before(i, p) - alpha * m_dx[d];
+      trial = residual(net, x, v, dt);
+      if (trial < norm) break;
+    }
+    if (!(trial < norm)) {
+      // No step length helps: back to the iterate, and refresh the factorisation once if it is stale.
+      x.leftCols(n) = m_x_before.leftCols(n);
+      norm = residual(net, x, v, dt);
+      if (fresh || !refactor(net, x, dt)) break;
+      ++report.factorisations;
+      fresh = true;
+      previous = INFINITY;
+      continue;
+    }
     previous = norm;
-    norm = residual(net, x, v, dt);
+    norm = trial;
+    fresh = false;
   }
   report.residual = norm;
   report.converged = norm <= tolerance;

@@ -1,7 +1,8 @@
 #pragma once
 // NewtonStepper: the network's implicit Euler step and its quasi-static equilibrium, both solved
 // by Newton's method on the free degrees of freedom with a sparse LDLᵀ factorisation that is
-// kept while it still converges (modified Newton) and refreshed when it does not.
+// kept while it still converges (modified Newton) and refreshed when it does not, with a
+// backtracking line search on the residual so that a step far from the solution never diverges.
 
 #include "realtime/springs/network_system.hpp"
 #include "realtime/springs/spring_network.hpp"
@@ -25,18 +26,20 @@ public:
     quasi_static
   };
 
-  /// Builds the system's pattern for `net` (allocates). `max_iterations` >= 1 per advance.
-  NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations);
+  /// Builds the system's pattern for `net` (allocates). `max_iterations` >= 1 per advance;
+  /// `relative_tolerance` ε > 0: converged when the residual's max-norm is <= ε k₁ h [N] (the
+  /// force of an edge spring stretched by ε of its length).
+  NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations, double relative_tolerance = 1e-9);
 
   /// Re-analyses after the network's cells, nodes or constraints changed (a tear). Allocates.
   void rebuild(const SpringNetwork& net);
 
   /// Advances (x, v) by dt [s]. On entry the free axes hold the state at tₙ and the fixed axes
-  /// their prescribed end-of-step positions and velocities. The residual tolerance is 10⁻⁹ k₁ h
-  /// [N]. The Jacobian A = M/h² + (1 + τ/h) K_T (implicit) or K_T + 10⁻⁸ (‖K‖/‖M‖) M (quasi-static; the
+  /// their prescribed end-of-step positions and velocities. The Jacobian A = M/h² + (1 + τ/h) K_T (implicit) or K_T + 10⁻⁸ (‖K‖/‖M‖) M (quasi-static; the
   /// small mass term only regularises floating pieces and leaves the solution unchanged) is
   /// factorised on the first call, when dt changes, and whenever an iteration reduces the
-  /// residual by less than a factor 4. Allocation-free.
+  /// residual by less than a factor 4, or when no step length of the line search (1, 1/2, …,
+  /// 1/32 of the Newton step) lowers the residual. Allocation-free.
   NewtonReport advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
 
 private:
@@ -46,9 +49,10 @@ private:
   Mode m_mode;
   int m_max_iterations;
   NetworkSystem m_system;
+  double m_tolerance_ratio;
   double m_factor_dt = -1.0;
   double m_static_regularisation = 0.0;
-  Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero;
+  Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
   Eigen::VectorXd m_r, m_dx;
 };
 

@@ -93,7 +93,42 @@ SpringNetwork build_spring_network(const NetworkBlock& block, const std::vector<
   for (const auto& corners : net.cell_nodes)
     for (int id : corners) net.mass[static_cast<std::size_t>(id)] += net.cell_mass / 8.0;
   net.constraint.assign(static_cast<std::size_t>(capacity), 0);
+  const std::size_t springs = 28 * static_cast<std::size_t>(net.cell_count());
+  for (std::vector<int>* v : {&net.springs.a, &net.springs.b}) v->assign(springs, 0);
+  for (std::vector<double>* v : {&net.springs.k, &net.springs.rest, &net.springs.key_k}) v->assign(springs, 0.0);
+  net.springs.key.assign(springs, 0);
+  merge_springs(net);
   return net;
+}
+
+void merge_springs(SpringNetwork& net) noexcept {
+  SpringArrays& s = net.springs;
+  // Key (a, b, kind) with a < b: a in bits 34-63, b in bits 4-33, kind in bits 0-3; the cell
+  // index in the low bits of a second array is not needed, the constant travels with the key.
+  const std::size_t n = 28 * static_cast<std::size_t>(net.cell_count());
+  std::size_t m = 0;
+  for (const auto& nodes : net.cell_nodes)
+    for (const CellSpring& cs : cell_springs) {
+      const auto p = static_cast<std::uint64_t>(nodes[static_cast<std::size_t>(cs.a)]);
+      const auto q = static_cast<std::uint64_t>(nodes[static_cast<std::size_t>(cs.b)]);
+      s.key[m++] = (std::min(p, q) << 34) | (std::max(p, q) << 4) | static_cast<std::uint64_t>(cs.type);
+    }
+  std::sort(s.key.begin(), s.key.begin() + static_cast<std::ptrdiff_t>(n));
+  int count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t key = s.key[i];
+    const int type = static_cast<int>(key & 15u);
+    if (i > 0 && key == s.key[i - 1]) {
+      s.k[static_cast<std::size_t>(count - 1)] += net.spring_constant(type);
+      continue;
+    }
+    s.a[static_cast<std::size_t>(count)] = static_cast<int>(key >> 34);
+    s.b[static_cast<std::size_t>(count)] = static_cast<int>((key >> 4) & ((std::uint64_t{1} << 30) - 1));
+    s.k[static_cast<std::size_t>(count)] = net.spring_constant(type);
+    s.rest[static_cast<std::size_t>(count)] = net.rest_length(type);
+    ++count;
+  }
+  s.count = count;
 }
 
 Eigen::Matrix3d cell_deformation_gradient(const Eigen::Matrix<double, 3, 8>& corners, double h) {
@@ -178,15 +213,50 @@ double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const
                       Eigen::Matrix3Xd& f) noexcept {
   f.leftCols(net.node_count).setZero();
   double energy = 0.0;
-  Eigen::Matrix<double, 3, 8> xc, vc, fc;
-  for (int c = 0; c < net.cell_count(); ++c) {
-    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(c)];
-    for (int a = 0; a < 8; ++a) {
-      xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
-      vc.col(a) = v.col(nodes[static_cast<std::size_t>(a)]);
+  const double tau = net.damping_time;
+  const double tiny = 1e-12 * net.block.cell_size;
+  const double* xd = x.data();
+  const double* vd = v.data();
+  double* fd = f.data();
+  const SpringArrays& s = net.springs;
+  const int* sa = s.a.data();
+  const int* sb = s.b.data();
+  const double* sk = s.k.data();
+  const double* sl = s.rest.data();
+  for (int i = 0; i < s.count; ++i) {
+    const int a = 3 * sa[i], b = 3 * sb[i];
+    const double ex = xd[b] - xd[a], ey = xd[b + 1] - xd[a + 1], ez = xd[b + 2] - xd[a + 2];
+    const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double inv_l = l > tiny ? 1.0 / l : 0.0; // coincident ends: no direction, no force
+    const double stretch = l - sl[i];
+    const double rate = (vd[b] - vd[a]) * ex + (vd[b + 1] - vd[a + 1]) * ey + (vd[b + 2] - vd[a + 2]) * ez;
+    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
+    const double scale = sk[i] * (stretch + tau * rate * inv_l) * inv_l;
+    fd[a] += scale * ex, fd[a + 1] += scale * ey, fd[a + 2] += scale * ez;
+    fd[b] -= scale * ex, fd[b + 1] -= scale * ey, fd[b + 2] -= scale * ez;
+    energy += 0.5 * sk[i] * stretch * stretch * (inv_l > 0.0 ? 1.0 : 0.0);
+  }
+  const double kappa = net.stiffness.volume_modulus;
+  if (kappa > 0.0) {
+    const double h = net.block.cell_size;
+    const double V0 = h * h * h;
+    Eigen::Matrix<double, 3, 8> xc;
+    for (const auto& nodes : net.cell_nodes) {
+      for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
+      const Eigen::Matrix3d F = cell_deformation_gradient(xc, h);
+      const double J = F.determinant();
+      const Eigen::Matrix3d cof = cofactor(F);
+      Eigen::Matrix<double, 3, 8> dJ; // ∂J/∂x_a = cof(F) g_a
+      double J_rate = 0.0;
+      for (int a = 0; a < 8; ++a) {
+        dJ.col(a) = cof * (corner_sign(a) / (4.0 * h));
+        J_rate += dJ.col(a).dot(v.col(nodes[static_cast<std::size_t>(a)]));
+      }
+      // f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a
+      const double pressure = kappa * V0 * ((J - 1.0) + tau * J_rate);
+      for (int a = 0; a < 8; ++a) f.col(nodes[static_cast<std::size_t>(a)]) -= pressure * dJ.col(a);
+      energy += 0.5 * kappa * V0 * (J - 1.0) * (J - 1.0);
     }
-    energy += cell_forces(net, c, xc, vc, fc);
-    for (int a = 0; a < 8; ++a) f.col(nodes[static_cast<std::size_t>(a)]) += fc.col(a);
   }
   return energy;
 }

@@ -33,8 +33,23 @@ extern const std::array<CellSpring, 28> cell_springs;
 /// Node constraint bits: a fixed axis keeps the position the caller gives it (supports, tools).
 enum NodeConstraint : std::uint8_t { fix_x = 1, fix_y = 2, fix_z = 4, fix_all = 7 };
 
+/// The network's springs as flat arrays (structure of arrays) for the force loop: the 28 springs
+/// of every cell, with parallel springs — the same two nodes and kind, an edge shared by up to
+/// four cells, a face diagonal by two — merged into one of the summed constant (which halves the
+/// springs of a full block). Sized for 28 springs per cell so that a rebuild after a tear
+/// allocates nothing; springs [0, count) are in use.
+struct SpringArrays {
+  std::vector<int> a, b;       ///< end nodes
+  std::vector<double> k;       ///< constant [N/m] (sum over the merged cells' springs)
+  std::vector<double> rest;    ///< rest length L [m]
+  std::vector<std::uint64_t> key; ///< workspace: (a, b, kind) packed, for sorting
+  std::vector<double> key_k;      ///< workspace: constant by key
+  int count = 0;
+};
+
 /// The network (paper 000 §2.1). Node arrays are sized for `node_capacity()` so that tearing
 /// can add copies of split vertices without allocating; nodes [0, node_count) are in use.
+/// Whoever re-points `cell_nodes` (a tear) calls `merge_springs` afterwards.
 struct SpringNetwork {
   NetworkBlock block;
   CellStiffness stiffness;
@@ -47,6 +62,7 @@ struct SpringNetwork {
   std::vector<double> mass;                    ///< [kg]
   std::vector<std::uint8_t> constraint;        ///< NodeConstraint bits
   int node_count = 0;
+  SpringArrays springs;                        ///< from cell_nodes by merge_springs
 
   [[nodiscard]] int cell_count() const { return static_cast<int>(cell_nodes.size()); }
   [[nodiscard]] int node_capacity() const { return static_cast<int>(rest.cols()); }
@@ -61,6 +77,11 @@ struct SpringNetwork {
 /// as given, τ = η / E. Throws std::invalid_argument on bad sizes, no kept cell, or ρ <= 0.
 SpringNetwork build_spring_network(const NetworkBlock& block, const std::vector<bool>& keep,
                                    const CellStiffness& stiffness, double density, double damping_time);
+
+/// Rebuilds `net.springs` from the cells' corners: every cell spring (a, b, kind) keyed, sorted
+/// in place, equal keys merged with summed constants. Allocation-free once the arrays are sized
+/// (build_spring_network sizes them).
+void merge_springs(SpringNetwork& net) noexcept;
 
 /// The deformation gradient of a cell at its centre from its corners x_a (trilinear shape
 /// functions): F = Σ_a x_a ⊗ g_a, g_a = s_a / (4h) with s_a the corner's sign vector (±1)³.
@@ -80,8 +101,10 @@ double cell_forces(const SpringNetwork& net, int cell, const Eigen::Matrix<doubl
 void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
                            Eigen::Matrix<double, 24, 24>& K) noexcept;
 
-/// Sum of all cells' internal forces into f (3 x capacity, overwritten for nodes in use);
-/// returns the elastic energy [J]. Allocation-free.
+/// Sum of all cells' internal forces into f (3 x capacity, overwritten for nodes in use), the
+/// same forces as cell_forces summed over the cells but with the springs taken from the merged
+/// flat arrays (`net.springs`) and the volume term per cell; returns the elastic energy [J].
+/// Allocation-free.
 double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                       Eigen::Matrix3Xd& f) noexcept;
 

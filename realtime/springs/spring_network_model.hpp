@@ -54,6 +54,9 @@ struct SpringNetworkSetup {
   SpringIntegrator integrator = SpringIntegrator::symplectic_euler;
   bool tearing = false;
   double tensile_limit = 0.0;   ///< σ_max [Pa] > 0 when tearing
+  /// Grasp radius [m]: network nodes within it of a stylus tip centre are attached to the stylus;
+  /// 0: the tip radius plus half a cell, r + h/2.
+  double grasp_radius = 0.0;
   std::vector<SpringSupport> supports;
   std::vector<SpringStylus> styluses; ///< one or two
 };
@@ -68,7 +71,8 @@ struct SpringNetworkSetup {
 /// 3. supports: nodes within h/4 of a support surface are fixed (bonded) or fixed along its normal
 ///    (sliding); nodes on the block's outer faces where the body continues outside the block are
 ///    fixed (the material beyond the network is taken as rigid).
-/// 4. styluses: nodes within r + h/2 of a tip centre (at least the nearest one) are attached to it
+/// 4. styluses: nodes within the grasp radius (r + h/2 unless given) of a tip centre (at least the
+///    nearest one) are attached to it
 ///    and move with it (paper 000 §2.1: "the vertices at the stylus tip is fixed to the stylus").
 /// `step`: attached nodes follow the stylus; the network is advanced by dt with the integrator;
 /// the force on each stylus is the sum of the internal forces on its attached nodes; mode is
@@ -92,6 +96,8 @@ public:
   [[nodiscard]] double stability_limit() const { return m_stability_limit; } ///< explicit h_crit [s]
   [[nodiscard]] int last_substeps() const { return m_last_substeps; }
   [[nodiscard]] int tears() const { return m_tears; }     ///< vertex splits so far
+  /// Numeric factorisations the implicit or quasi-static integrator made since reset().
+  [[nodiscard]] long factorisations() const { return m_factorisations; }
   [[nodiscard]] int pieces() const { return m_pieces; }   ///< connected pieces of the network
   [[nodiscard]] int attached_nodes(int stylus) const;
 
@@ -112,6 +118,7 @@ private:
   std::vector<double> m_gershgorin_work;
   int m_last_substeps = 0;
   int m_tears = 0;
+  long m_factorisations = 0;
   int m_pieces = 1;
   std::unique_ptr<NewtonStepper> m_newton;
   std::unique_ptr<VertexTearing> m_tearing;

@@ -19,7 +19,7 @@ double highest_angular_frequency(const SpringNetwork& net) {
     for (int i = 0; i < 3; ++i)
       if (const int d = system.dof_of()[static_cast<std::size_t>(3 * p + i)]; d >= 0)
         inv_sqrt_m[d] = 1.0 / std::sqrt(net.mass[static_cast<std::size_t>(p)]);
-  const auto K = system.matrix().selfadjointView<Eigen::Upper>();
+  const auto K = system.matrix().selfadjointView<Eigen::Lower>();
   // Power iteration on S = M^(-1/2) K M^(-1/2) from a deterministic, mode-rich start vector.
   Eigen::VectorXd u(n), w(n);
   for (int k = 0; k < n; ++k) u[k] = std::sin(1.0 + 12.9898 * k) + ((k % 2) ? 0.5 : -0.5);

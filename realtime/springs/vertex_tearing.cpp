@@ -44,6 +44,7 @@ VertexTearing::VertexTearing(const SpringNetwork& net, double tensile_limit) : m
   if (!(tensile_limit > 0.0)) throw std::invalid_argument("VertexTearing: the tensile limit must be > 0 Pa");
   m_stress.assign(static_cast<std::size_t>(net.node_capacity()), Eigen::Matrix3d::Zero());
   m_cells.assign(static_cast<std::size_t>(net.node_capacity()), 0);
+  m_opened.assign(static_cast<std::size_t>(net.node_capacity()), 0);
 }
 
 bool VertexTearing::tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
@@ -70,7 +71,7 @@ bool VertexTearing::tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3
   m_last_max = 0.0;
   for (int p = 0; p < n; ++p) {
     const int count = m_cells[static_cast<std::size_t>(p)];
-    if (count < 2 || excluded[static_cast<std::size_t>(p)]) continue;
+    if (count < 2 || excluded[static_cast<std::size_t>(p)] || m_opened[static_cast<std::size_t>(p)]) continue;
     eigen.computeDirect(m_stress[static_cast<std::size_t>(p)] / count);
     const double s1 = eigen.eigenvalues()[2];
     m_last_max = std::max(m_last_max, s1);
@@ -126,6 +127,8 @@ bool VertexTearing::tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3
   const double total_cells = m_cells[static_cast<std::size_t>(worst)];
   net.mass[static_cast<std::size_t>(copy)] = moved * net.cell_mass / 8.0;
   net.mass[static_cast<std::size_t>(worst)] = (total_cells - moved) * net.cell_mass / 8.0;
+  m_opened[static_cast<std::size_t>(worst)] = m_opened[static_cast<std::size_t>(copy)] = 1;
+  merge_springs(net);
   return true;
 }
 

@@ -29,11 +29,13 @@ public:
   /// `tensile_limit` σ_max [Pa] > 0 (the scene's cohesive strength).
   VertexTearing(const SpringNetwork& net, double tensile_limit);
 
-  /// Finds the vertex (shared by >= 2 cells, not `excluded`) whose averaged cell stress has the
-  /// largest principal value σ₁ > σ_max, and splits it: the cells whose own force on the vertex
-  /// points along +n₁ (the tension direction) keep it, the others get a copy of it (position,
-  /// velocity, rest position and constraint copied; mass re-lumped). At most one split per call.
-  /// Returns true if a vertex was split. `excluded` has one entry per node (capacity).
+  /// Finds the vertex (shared by >= 2 cells, not `excluded`, not split before) whose averaged
+  /// cell stress has the largest principal value σ₁ > σ_max, and splits it: the cells whose own
+  /// force on the vertex points along +n₁ (the tension direction) keep it, the others get a copy
+  /// of it (position, velocity, rest position and constraint copied; mass re-lumped). At most one
+  /// split per call, and each vertex splits once: the vertex and its copy are not split again
+  /// (a crack does not branch at a vertex it has opened). Returns true if a vertex was split.
+  /// `excluded` has one entry per node (capacity).
   bool tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, const std::vector<std::uint8_t>& excluded) noexcept;
 
   /// Largest principal vertex stress found by the last `tear` [Pa].
@@ -44,6 +46,7 @@ private:
   double m_last_max = 0.0;
   std::vector<Eigen::Matrix3d> m_stress; ///< per node, summed over its cells
   std::vector<int> m_cells;              ///< per node, number of cells
+  std::vector<std::uint8_t> m_opened;    ///< per node: split before (or the copy of a split vertex)
 };
 
 } // namespace kerf

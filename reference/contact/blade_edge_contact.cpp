@@ -95,7 +95,10 @@ BladeEdgeContact blade_edge_contact(const RigidToolShape& blade, const Eigen::Ve
     if (!inside) continue;
     const auto& [c, d] = nearest.front();
     EdgeContactTerm term;
+    term.facet = c->facet;
     term.nodes = facets[c->facet];
+    term.weight = w;
+    term.line_load = settings.line_penalty * std::sqrt(d.squared_distance);
     // W = ½ ε_L w d²: f = −∂W/∂x = −½ ε_L w ∇d², ∂²W/∂x² = ½ ε_L w ∇²d²
     const double k = 0.5 * settings.line_penalty * w;
     term.force_on_body = -k * d.gradient;

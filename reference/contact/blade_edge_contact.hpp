@@ -38,7 +38,10 @@ struct BladeEdgeContactSettings {
 
 /// One active edge point's contribution, on the three nodes of its facet.
 struct EdgeContactTerm {
+  std::size_t facet = 0;   ///< index of the facet in the `facets` passed to blade_edge_contact
   BoundaryFacet nodes{};
+  double weight = 0.0;     ///< the edge point's share w of the edge length [m]
+  double line_load = 0.0;  ///< ε_L d [N/m]
   Eigen::Matrix<double, 9, 1> force_on_body = Eigen::Matrix<double, 9, 1>::Zero(); ///< f_i [N]
   Eigen::Matrix<double, 9, 9> stiffness = Eigen::Matrix<double, 9, 9>::Zero();     ///< ∂²W/∂x² [N/m]
 };

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <stdexcept>
 #include <utility>
 
 namespace kerf::reference::test {
@@ -114,6 +115,28 @@ TetMesh cook_membrane(int n) {
     mesh.nodes(v, 1) = (lower + y / 44.0 * (upper - lower)) * 1e-3;
   }
   return mesh;
+}
+
+void add_interior_face_group(TetMesh& mesh, const std::string& name, const std::function<bool(const Eigen::Vector3d&)>& on_surface) {
+  // Local vertices of the face opposite vertex k (any winding: crack_split orients by the sides).
+  constexpr int opposite[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+  const Eigen::MatrixXi adjacency = tet_face_adjacency(mesh.tets);
+  std::vector<std::array<int, 3>> rows;
+  for (Eigen::Index t = 0; t < mesh.tets.rows(); ++t)
+    for (int k = 0; k < 4; ++k) {
+      if (adjacency(t, k) < t) continue; // boundary, or seen from the other tetrahedron already
+      std::array<int, 3> tri{};
+      bool on = true;
+      for (int j = 0; j < 3; ++j) {
+        tri[static_cast<std::size_t>(j)] = mesh.tets(t, opposite[k][j]);
+        on = on && on_surface(mesh.nodes.row(tri[static_cast<std::size_t>(j)]).transpose());
+      }
+      if (on) rows.push_back(tri);
+    }
+  SurfaceGroup group{name, static_cast<int>(mesh.surface_groups.size()) + 100, Eigen::MatrixXi(static_cast<Eigen::Index>(rows.size()), 3)};
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    for (int j = 0; j < 3; ++j) group.triangles(static_cast<Eigen::Index>(r), j) = rows[r][static_cast<std::size_t>(j)];
+  mesh.surface_groups.push_back(std::move(group));
 }
 
 } // namespace kerf::reference::test

@@ -4,6 +4,9 @@
 
 #include "meshes/tet_mesh.hpp"
 
+#include <functional>
+#include <string>
+
 namespace kerf::reference::test {
 
 /// box_tet_mesh with its surface groups replaced by the six faces `xmin`, `xmax`, `ymin`,
@@ -24,5 +27,9 @@ TetMesh macneal_harder_patch();
 /// 1 mm thick (z in [-0.5, 0.5] mm), n by n by 1 cells, each split into 6 tetrahedra. Surface
 /// groups `xmin` (clamped), `xmax` (loaded), `zmin`, `zmax`. Units: metres.
 TetMesh cook_membrane(int n);
+
+/// Adds the surface group `name`: the interior faces (shared by two tetrahedra) whose three nodes
+/// all satisfy `on_surface`, e.g. a grid plane of a box mesh to be split into a crack path.
+void add_interior_face_group(TetMesh& mesh, const std::string& name, const std::function<bool(const Eigen::Vector3d&)>& on_surface);
 
 } // namespace kerf::reference::test

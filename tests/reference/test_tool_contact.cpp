@@ -42,6 +42,30 @@ TEST(RigidTool, WedgeNearestExit) {
   EXPECT_THROW(validate(bad), std::invalid_argument);
 }
 
+TEST(RigidTool, WedgePushesACrackFaceToItsOwnSide) {
+  RigidToolShape w;
+  w.kind = RigidToolShape::Kind::wedge;
+  w.wedge_angle = std::numbers::pi / 2.0; // flanks at 45°
+  w.thickness = 10e-3;
+  // Edge along y cutting down (−z): m = e × d = −x; flank normals (−sin45, 0, −sin45)·… i.e.
+  // n₁ = sin45 (−z) + cos45 (−x), n₂ = sin45 (−z) + cos45 (+x). A point 0.1 mm on the −x side of
+  // the blade plane, 1 mm above the edge: its nearest exit is flank n₁ (towards −x), at
+  // s₁ = (−0.1, 0, 1) mm · n₁ = (0.1 − 1) sin45 mm, penetration 0.9 sin45 mm.
+  const Eigen::Vector3d x(-0.1e-3, 0.0, 1e-3);
+  const ToolContactPoint free = tool_contact(w, Eigen::Vector3d::Zero(), x);
+  ASSERT_TRUE(free.inside);
+  EXPECT_NEAR(free.penetration, 0.9e-3 * std::sin(std::numbers::pi / 4.0), 1e-15);
+  EXPECT_LT(free.normal.x(), 0.0);
+  // The same point on the crack face whose material lies towards +x may only leave towards +x:
+  // through flank n₂, s₂ = (−0.1, 0, 1) mm · n₂ = (−0.1 − 1) sin45 mm, penetration 1.1 sin45 mm.
+  const ToolContactPoint own = tool_contact(w, Eigen::Vector3d::Zero(), x, Eigen::Vector3d::UnitX());
+  ASSERT_TRUE(own.inside);
+  EXPECT_NEAR(own.penetration, 1.1e-3 * std::sin(std::numbers::pi / 4.0), 1e-15);
+  EXPECT_NEAR((own.normal - std::sin(std::numbers::pi / 4.0) * Eigen::Vector3d(1, 0, -1)).norm(), 0.0, 1e-12);
+  // A side does not make an outside point inside.
+  EXPECT_FALSE(tool_contact(w, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -1e-4), Eigen::Vector3d::UnitX()).inside);
+}
+
 TEST(ToolContact, ContactResultantBalancesTheSupportReaction) {
   const double L = 0.02, R = 4e-3;
   FiniteStrainProblem p;

@@ -423,7 +423,7 @@ TEST_F(SceneReaderTest, ErrorsNameTheFileAsGiven) {
   } catch (const SceneError& e) {
     const std::string m = e.what();
     EXPECT_EQ(m.rfind(p.string() + ":", 0), 0u) << m;
-    EXPECT_NE(m.find(": models.fracturre: unknown key (expected one of: fracture, voxel)"), std::string::npos) << m;
+    EXPECT_NE(m.find(": models.fracturre: unknown key (expected one of: fracture, voxel, springs)"), std::string::npos) << m;
   }
 }
 

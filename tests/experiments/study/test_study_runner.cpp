@@ -3,9 +3,13 @@
 
 #include "experiments/study/study_runner.hpp"
 
+#include "experiments/run/scene_mesh.hpp"
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 
 #include <unistd.h>
@@ -149,4 +153,101 @@ TEST(StudyRunner, EndToEndWithTheReferenceAndItsCache) {
       EXPECT_EQ(first.rows[k].metrics->normalised_rms_force_error, second.rows[k].metrics->normalised_rms_force_error);
     }
   }
+}
+
+namespace {
+
+/// The study's CSV table without its cost columns (median, p99, max cost and the rate they
+/// allow): the columns a run beside another may change. RFC 4180 fields, quotes kept.
+std::string without_cost_columns(const std::string& csv) {
+  std::string out;
+  std::vector<bool> keep;
+  std::size_t start = 0;
+  while (start < csv.size()) {
+    const std::size_t end = csv.find('\n', start);
+    const std::string line = csv.substr(start, end - start);
+    start = end == std::string::npos ? csv.size() : end + 1;
+    std::vector<std::string> fields(1);
+    bool quoted = false;
+    for (char c : line) {
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) fields.emplace_back();
+      else fields.back() += c;
+    }
+    if (keep.empty())
+      for (const std::string& f : fields) keep.push_back(f.find("cost") == std::string::npos && f.find("rate allowed") == std::string::npos);
+    for (std::size_t k = 0; k < fields.size(); ++k)
+      if (k < keep.size() && keep[k]) out += fields[k] + ",";
+    out += "\n";
+  }
+  return out;
+}
+
+} // namespace
+
+TEST(StudyRunner, ParallelRunsGiveTheSerialTablesApartFromCosts) {
+  // Two scenes, three models (seven runs, two of them with calibrated parameters) and a fake
+  // reference whose profile is the fracture model's own: one job, then three jobs. The tables must be
+  // byte-identical once the cost columns (timing, disturbed by neighbours) are dropped — and the
+  // cost columns must be there (the test would pass vacuously on an empty table otherwise).
+  const fs::path dir = fs::temp_directory_path() / ("kerf_test_study_jobs_" + std::to_string(::getpid()));
+  fs::create_directories(dir / "calibration");
+  std::ofstream(dir / "calibration" / "fracture.toml") << "[models.fracture]\nrupture_force_per_length = \"350 N/m\"\n";
+  const StudySpec spec = read_study(write_study(
+      "jobs.toml", "[study]\nname = \"jobs\"\nscenes = [\"potato_rect_cut\", \"potato_wedge_cut\"]\n"
+                   "models = [\"fracture\", \"edge\", \"springs\"]\n[reference]\nrefinements = [0]\nsamples = 40\n"
+                   "[calibration]\npotato_rect_cut = [\"" + (dir / "calibration" / "fracture.toml").string() + "\"]\n"));
+  // The fake reference: the fracture model's profile of the scene at the chosen samples.
+  const ReferenceRunner fake = [](const Scene& scene, const StudyReferenceSpec&, int, const std::vector<std::size_t>& indices,
+                                  const fs::path&) {
+    const TetMesh mesh = scene_mesh(scene);
+    BuiltModel built = make_model("fracture", scene, mesh);
+    return subsample(run_model(*built.model, {scene.tools.front().name}, sample_scene_trajectories(scene)), indices);
+  };
+  StudyExecution serial, parallel;
+  parallel.jobs = 3;
+  const fs::path a = dir / "serial", b = dir / "parallel";
+  fs::remove_all(a);
+  fs::remove_all(b);
+  const StudyResult one = run_study(spec, a, fake, serial);
+  const StudyResult three = run_study(spec, b, fake, parallel);
+  ASSERT_EQ(one.rows.size(), 5u); // 2 x (fracture, edge) + fracture (calibrated); springs takes no blade
+  EXPECT_EQ(one.rows[1].model, "fracture (calibrated)");
+  EXPECT_TRUE(one.rows[0].metrics.has_value());
+  EXPECT_EQ(one.reference_runs, 2);
+  EXPECT_EQ(three.reference_runs, 2);
+  const std::string csv_one = one.table().csv(), csv_three = three.table().csv();
+  EXPECT_NE(csv_one.find("p99 cost"), std::string::npos);
+  // The filter drops exactly the four cost columns (median, p99, max, rate allowed) of 13.
+  const std::string header = without_cost_columns(csv_one.substr(0, csv_one.find('\n')));
+  EXPECT_EQ(std::count(header.begin(), header.end(), ','), 9);
+  // Same tables to round-off: a run beside others may sum its samples in another order (a metric of
+  // exactly 0 serially came out 4e-15 with three jobs), so numeric cells agree to 1e-9 relative and
+  // every other cell exactly.
+  const std::string table_one = without_cost_columns(csv_one), table_three = without_cost_columns(csv_three);
+  std::vector<std::string> cells_one, cells_three;
+  for (auto [table, cells] : {std::pair{&table_one, &cells_one}, std::pair{&table_three, &cells_three}}) {
+    std::string cell;
+    for (char c : *table)
+      if (c == ',' || c == '\n') {
+        cells->push_back(cell);
+        cell.clear();
+      } else {
+        cell += c;
+      }
+  }
+  ASSERT_EQ(cells_one.size(), cells_three.size());
+  for (std::size_t k = 0; k < cells_one.size(); ++k) {
+    char* end_one = nullptr;
+    char* end_three = nullptr;
+    const double a = std::strtod(cells_one[k].c_str(), &end_one), b = std::strtod(cells_three[k].c_str(), &end_three);
+    if (!cells_one[k].empty() && *end_one == '\0' && !cells_three[k].empty() && *end_three == '\0')
+      EXPECT_NEAR(a, b, 1e-9 * std::max({1.0, std::abs(a), std::abs(b)})) << "cell " << k << " of the table";
+    else
+      EXPECT_EQ(cells_one[k], cells_three[k]) << "cell " << k << " of the table";
+  }
+  // Calibrated parameters (f_r 350 instead of 300 N/m) change the fracture model's deformation-1 samples
+  // (40 samples over the 22.5 s trajectory: one per 0.58 mm of cut, two or three within δ_r = 1.5 mm),
+  // so its row differs from the plain one, which is the fake reference itself (error 0).
+  EXPECT_NE(one.rows[0].metrics->normalised_rms_force_error, one.rows[1].metrics->normalised_rms_force_error);
 }

@@ -50,6 +50,47 @@ Perturbed perturbed_block(bool supported, double stiffness_scale = 1.0) {
   return p;
 }
 
+TEST(SpringNetwork, MergedForcesEqualTheCellSum) {
+  // network_forces runs over merged parallel springs; the independent value is cell_forces (each
+  // cell's own 28 springs and volume term) summed cell by cell, with dashpots (τ > 0) and after
+  // a vertex of the block has been split by hand (merge_springs then un-merges its springs).
+  Perturbed p = perturbed_block(true);
+  p.net.damping_time = 2e-5;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+  for (int n = 0; n < p.net.node_count; ++n)
+    for (int i = 0; i < 3; ++i) p.v(i, n) = u(rng);
+  EXPECT_LT(p.net.springs.count, 28 * p.net.cell_count()); // shared edges and faces were merged
+  for (const bool split : {false, true}) {
+    if (split) { // the centre node of the 3^3 block's lower middle layer: cells with grid x = 1 take a copy
+      int centre = -1;
+      for (int n = 0; n < p.net.node_count; ++n)
+        if (test::grid_of(p.net, n) == Eigen::Vector3i(1, 1, 1)) centre = n;
+      ASSERT_GE(centre, 0);
+      const int copy = p.net.node_count++;
+      p.x.col(copy) = p.x.col(centre) + Eigen::Vector3d(1e-5, 0, 0);
+      p.v.col(copy) = p.v.col(centre);
+      for (int c = 0; c < p.net.cell_count(); ++c)
+        if (p.net.cell_index[static_cast<std::size_t>(c)].x() == 1)
+          for (int& id : p.net.cell_nodes[static_cast<std::size_t>(c)]) id = id == centre ? copy : id;
+      merge_springs(p.net);
+    }
+    Eigen::Matrix3Xd expected = Eigen::Matrix3Xd::Zero(3, p.net.node_capacity());
+    double expected_energy = 0.0;
+    Eigen::Matrix<double, 3, 8> xc, vc, fc;
+    for (int c = 0; c < p.net.cell_count(); ++c) {
+      const auto& nodes = p.net.cell_nodes[static_cast<std::size_t>(c)];
+      for (int a = 0; a < 8; ++a) xc.col(a) = p.x.col(nodes[static_cast<std::size_t>(a)]), vc.col(a) = p.v.col(nodes[static_cast<std::size_t>(a)]);
+      expected_energy += cell_forces(p.net, c, xc, vc, fc);
+      for (int a = 0; a < 8; ++a) expected.col(nodes[static_cast<std::size_t>(a)]) += fc.col(a);
+    }
+    const double energy = network_forces(p.net, p.x, p.v, p.f);
+    const double scale = expected.leftCols(p.net.node_count).cwiseAbs().maxCoeff();
+    EXPECT_LT((p.f - expected).leftCols(p.net.node_count).cwiseAbs().maxCoeff(), 1e-12 * scale) << "split " << split;
+    EXPECT_NEAR(energy, expected_energy, 1e-12 * expected_energy) << "split " << split;
+  }
+}
+
 TEST(SymplecticEuler, ConservesEnergyWithoutDamping) {
   for (const bool supported : {false, true}) {
     Perturbed p = perturbed_block(supported);

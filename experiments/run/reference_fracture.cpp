@@ -1,0 +1,106 @@
+#include "experiments/run/reference_fracture.hpp"
+
+#include "meshes/crack_split.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace kerf {
+
+CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem& problem, ReferenceFracture mode,
+                             int refinements) {
+  CrackPathInfo info;
+  if (mode == ReferenceFracture::off) return info;
+  const bool fractures = scene.phenomena.contains(Phenomenon::cutting) || scene.phenomena.contains(Phenomenon::tearing);
+  const bool has_plane = problem.mesh.find_surface_group("cut_plane") != nullptr;
+  const bool has_law = scene.material.cohesive_strength > 0.0 && scene.material.fracture_toughness > 0.0;
+  if (mode == ReferenceFracture::automatic && !(fractures && has_plane && has_law)) return info;
+  if (!has_plane)
+    throw std::invalid_argument("reference: scene '" + scene.name + "' (" + scene.file.string() +
+                                "): fracture needs a conformingly meshed surface group 'cut_plane' (the crack path)");
+  if (!has_law)
+    throw std::invalid_argument("reference: scene '" + scene.name + "' (" + scene.file.string() +
+                                "): fracture needs [material] cohesive_strength and fracture_toughness");
+
+  const CrackSplit split = split_along_surface(problem.mesh, "cut_plane");
+  problem.mesh = split.mesh;
+  reference::CohesiveInterfaceSpec spec;
+  spec.plus_surface = "cut_plane+";
+  spec.minus_surface = "cut_plane-";
+  spec.law.cohesive_strength = scene.material.cohesive_strength;
+  spec.law.fracture_toughness = scene.material.fracture_toughness;
+  problem.cohesive = spec;
+
+  info.active = true;
+  info.interface_triangles = static_cast<std::size_t>(split.plus_faces.rows());
+  info.zone_length = reference::cohesive_zone_length(scene.material.youngs_modulus, scene.material.poisson_ratio,
+                                                     scene.material.fracture_toughness, scene.material.cohesive_strength);
+  info.element_size = scene.geometry.element_size / std::pow(2.0, refinements);
+  info.elements_in_zone = reference::elements_in_cohesive_zone(info.zone_length, info.element_size);
+  if (info.elements_in_zone < reference::minimum_elements_in_cohesive_zone) {
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "the mesh is too coarse for the cohesive zone: l_cz = %.3g mm (σ_c = %.3g MPa, J_c = %.3g J/m²) spans "
+                  "%.2f elements of %.3g mm, fewer than %.0f (Turon et al. 2007); refine (--refine) or grade the mesh "
+                  "near cut_plane, or the force and dissipation depend on the mesh",
+                  info.zone_length * 1e3, scene.material.cohesive_strength * 1e-6, scene.material.fracture_toughness,
+                  info.elements_in_zone, info.element_size * 1e3, reference::minimum_elements_in_cohesive_zone);
+    info.warning = buf;
+  }
+  return info;
+}
+
+void EnergyBookkeeping::add_sample(const std::vector<Eigen::Vector3d>& positions, const std::vector<Eigen::Vector3d>& forces,
+                                   double strain_energy, const reference::CohesiveSummary& interface) {
+  if (positions.size() != forces.size()) throw std::invalid_argument("energy bookkeeping: one force per tool position");
+  if (!m_positions.empty()) {
+    if (m_positions.size() != positions.size()) throw std::invalid_argument("energy bookkeeping: the tool count changed");
+    for (std::size_t t = 0; t < positions.size(); ++t)
+      m_work += 0.5 * (forces[t] + m_forces[t]).dot(positions[t] - m_positions[t]); // trapezoid rule
+  }
+  m_positions = positions;
+  m_forces = forces;
+  m_strain = strain_energy;
+  m_interface = interface;
+}
+
+double EnergyBookkeeping::balance_error() const {
+  const double accounted = m_strain + m_interface.stored_energy + m_interface.dissipated_energy + m_interface.viscous_dissipation;
+  const double scale = std::max({std::abs(m_work), std::abs(accounted), 1e-300});
+  return (m_work - accounted) / scale;
+}
+
+nlohmann::json EnergyBookkeeping::to_json() const {
+  nlohmann::json positions = nlohmann::json::array(), forces = nlohmann::json::array();
+  for (std::size_t t = 0; t < m_positions.size(); ++t) {
+    positions.push_back({m_positions[t].x(), m_positions[t].y(), m_positions[t].z()});
+    forces.push_back({m_forces[t].x(), m_forces[t].y(), m_forces[t].z()});
+  }
+  return {{"external_work_J", m_work},
+          {"stored_elastic_energy_J", m_strain},
+          {"interface_energy_J", m_interface.stored_energy},
+          {"cohesive_dissipation_J", m_interface.dissipated_energy},
+          {"viscous_dissipation_J", m_interface.viscous_dissipation},
+          {"friction_dissipation_J", 0.0},
+          {"failed_area_m2", m_interface.failed_area},
+          {"balance_error", balance_error()},
+          {"last_positions_m", positions},
+          {"last_forces_on_body_N", forces}};
+}
+
+EnergyBookkeeping EnergyBookkeeping::from_json(const nlohmann::json& j) {
+  EnergyBookkeeping e;
+  e.m_work = j.at("external_work_J").get<double>();
+  e.m_strain = j.at("stored_elastic_energy_J").get<double>();
+  e.m_interface.stored_energy = j.at("interface_energy_J").get<double>();
+  e.m_interface.dissipated_energy = j.at("cohesive_dissipation_J").get<double>();
+  e.m_interface.viscous_dissipation = j.at("viscous_dissipation_J").get<double>();
+  e.m_interface.failed_area = j.at("failed_area_m2").get<double>();
+  for (const auto& p : j.at("last_positions_m")) e.m_positions.emplace_back(p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+  for (const auto& f : j.at("last_forces_on_body_N")) e.m_forces.emplace_back(f[0].get<double>(), f[1].get<double>(), f[2].get<double>());
+  return e;
+}
+
+} // namespace kerf

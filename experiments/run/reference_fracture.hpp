@@ -1,0 +1,69 @@
+#pragma once
+// The scene-level side of Reference II: a cutting or tearing scene's crack path (its conformingly
+// meshed `cut_plane`) split and joined by the bilinear cohesive law with the scene's σ_c and J_c,
+// the check that the mesh resolves the cohesive zone, the modes and crack extent read from the
+// interface, and the energy bookkeeping every run's manifest carries.
+//
+// Includes reference/*.hpp only, which include no deal.II.
+
+#include "experiments/scene/scene.hpp"
+#include "realtime/force_sample.hpp"
+#include "reference/cohesive/cohesive_zone.hpp"
+#include "reference/finite_strain_solver.hpp"
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include <string>
+
+namespace kerf {
+
+/// Whether a reference run models fracture along the crack path.
+enum class ReferenceFracture {
+  automatic, ///< when the scene has cutting or tearing, a `cut_plane` surface, σ_c and J_c
+  off,       ///< never: the body only deforms (Reference I)
+  on         ///< always; an error if the scene cannot have it
+};
+
+/// What `add_crack_path` did.
+struct CrackPathInfo {
+  bool active = false;
+  std::size_t interface_triangles = 0; ///< crack triangles joined by the cohesive law
+  double zone_length = 0.0;           ///< l_cz [m] (reference/cohesive/cohesive_zone.hpp)
+  double element_size = 0.0;          ///< the scene's element size after refinement [m]
+  double elements_in_zone = 0.0;      ///< l_cz / h
+  std::string warning;                ///< non-empty when l_cz / h < 3 (Turon et al. 2007)
+};
+
+/// If `mode` asks for it (see ReferenceFracture), splits `problem.mesh` along `cut_plane`
+/// (meshes/crack_split.hpp) and adds the cohesive interface with the scene's cohesive_strength and
+/// fracture_toughness. `refinements` (global, each halving h) enters the zone-resolution check.
+/// Throws std::invalid_argument naming the scene when `mode` is `on` and the scene has no
+/// cut_plane, σ_c or J_c.
+CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem& problem, ReferenceFracture mode,
+                             int refinements);
+
+/// The energy bookkeeping of a run (issue 4): external work by the tools on the body
+/// (trapezoid rule over the solved samples, W = Σ ½ (F_k + F_{k−1})·(x_k − x_{k−1}) with F the force
+/// of the tool on the body), stored elastic energy ∫ψ dV, interface energy, cohesive dissipation,
+/// viscous dissipation, friction dissipation (0: the reference tool is frictionless), and the
+/// balance error (W − stored − interface − dissipations) / max(W, stored + …).
+class EnergyBookkeeping {
+public:
+  /// One solved sample: the tool reference points [m] and the forces of the tools on the body [N]
+  /// (one entry per tool), the body's strain energy [J] and the interface summary.
+  void add_sample(const std::vector<Eigen::Vector3d>& positions, const std::vector<Eigen::Vector3d>& forces_on_body,
+                  double strain_energy, const reference::CohesiveSummary& interface);
+  [[nodiscard]] double external_work() const { return m_work; }
+  [[nodiscard]] double balance_error() const;
+  [[nodiscard]] nlohmann::json to_json() const;
+  /// Restores the bookkeeping from to_json() (a checkpoint).
+  static EnergyBookkeeping from_json(const nlohmann::json& j);
+
+private:
+  std::vector<Eigen::Vector3d> m_positions, m_forces;
+  double m_work = 0.0, m_strain = 0.0;
+  reference::CohesiveSummary m_interface;
+};
+
+} // namespace kerf

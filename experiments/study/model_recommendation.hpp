@@ -1,0 +1,42 @@
+#pragma once
+// Model selection (issue 7, "Model selection"): from the measured study tables, the cheapest
+// model that keeps a scene's force error within a budget at a servo rate — with the table row
+// that shows it — or "none" and why.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace kerf {
+
+/// One scored row of a study table (study.csv, study_runner.hpp's columns).
+struct MeasuredRow {
+  std::filesystem::path table;        ///< the CSV it came from
+  std::size_t line = 0;               ///< its line in that file (header = 1)
+  std::string scene, model;           ///< model with its variant ("springs (calibrated)")
+  std::optional<double> rms_error;    ///< normalised RMS force error [–]
+  std::optional<double> p99_cost;     ///< p99 cost per servo step [s]
+  std::string text;                   ///< the row as written, the evidence
+};
+
+/// Reads the scored rows of a study.csv (columns "scene", "model", "RMS force error [%]",
+/// "p99 cost [µs]"; RFC 4180 quoting). Throws std::runtime_error naming file:line on a malformed
+/// file or missing columns.
+std::vector<MeasuredRow> read_study_rows(const std::filesystem::path& csv);
+
+/// Every study.csv under `directory` (recursively), or `directory` itself if it is a file; sorted.
+std::vector<std::filesystem::path> find_study_tables(const std::filesystem::path& directory);
+
+struct Recommendation {
+  std::optional<MeasuredRow> choice; ///< empty: none meets the budget
+  std::string reason;                ///< why this row, or why none
+};
+
+/// Among the fast-model rows of `scene` (reference rows excluded) with a measured error ≤
+/// `max_error` and a p99 cost ≤ 1 / `rate` (the servo period), the one with the smallest p99
+/// cost (ties: the smaller error, then the earlier row). `rate` in Hz > 0, `max_error` ≥ 0.
+Recommendation recommend_model(const std::vector<MeasuredRow>& rows, const std::string& scene, double max_error,
+                               double rate);
+
+} // namespace kerf

@@ -1,0 +1,159 @@
+#!/usr/bin/env bash
+# Fault injection on `kerf reference` (issue 10, docs/reliability.md), through the command line
+# and nothing else: clay_pull on a 5 mm mesh (the scene as shipped, only element_size changed, so
+# one run takes seconds), 11 evenly spaced samples (checkpoints after samples 5 and 10).
+#   1. an uninterrupted run: the profile every other run must reproduce;
+#   2. SIGKILL at seeded random times (five kills), each followed by `--resume`: after
+#      every kill, no output under a final name is half written; the final profile equals the
+#      uninterrupted one (every column but cost_s, as written, to the last digit);
+#   3. a full disk (SIGXFSZ ignored and RLIMIT_FSIZE set in the child, so writes fail as on a
+#      full disk instead of killing it): a failure with a message, every finished output whole;
+#      then `--resume` without the limit reproduces the profile;
+#   4. an absurd load increment (the stylus jumps 2 m instead of 8 mm): the load path cuts back,
+#      or stops with the last converged state saved (profile, manifest with the reason,
+#      checkpoint), never a crash or a NaN.
+#
+#   reference_faults.sh KERF SCENES_DIR WORK_DIR
+set -euo pipefail
+kerf="$1"
+scenes="$2"
+work="$3"
+py=/usr/bin/python3
+rm -rf "$work"
+mkdir -p "$work"
+cd "$work"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+sed 's/^element_size = "2.5 mm"/element_size = "5 mm"/' "$scenes/clay_pull.toml" > coarse.toml
+grep -q '^element_size = "5 mm"' coarse.toml || fail "clay_pull.toml has no element_size line to coarsen"
+samples=11
+
+# Every output under a final name is whole: the profile's rows have 11 columns and end in a
+# newline, the manifest is JSON, fields.pvd and every .vtu end with their closing tag.
+check_whole() {
+  local dir="$1"
+  [ ! -e "$dir/profile.csv" ] || $py - "$dir/profile.csv" <<'PY' || fail "$dir/profile.csv is half written"
+import sys
+text = open(sys.argv[1]).read()
+lines = text.split("\n")
+assert text.endswith("\n") and lines[0] == "t,tool,px,py,pz,fx,fy,fz,mode,crack_extent,cost_s", "header or last newline"
+for line in lines[1:-1]:
+    assert len(line.split(",")) == 11, line
+PY
+  [ ! -e "$dir/manifest.json" ] || $py -c 'import json,sys; json.load(open(sys.argv[1]))' "$dir/manifest.json" \
+    || fail "$dir/manifest.json is half written"
+  for f in "$dir/fields.pvd" "$dir"/fields/*.vtu; do
+    [ -e "$f" ] || continue
+    case "$f" in *.tmp.*) continue ;; esac # a temporary file beside its final name (atomic_file.hpp)
+    tail -c 64 "$f" | grep -q '</VTKFile>' || fail "$f is half written"
+  done
+}
+
+# The profile without its cost column (compute seconds differ from run to run).
+physics() { cut -d, -f1-10 "$1"; }
+
+# 1. Uninterrupted.
+start=$(date +%s.%N)
+"$kerf" reference coarse.toml --samples $samples --no-fields -o whole > whole.log 2>&1 || { cat whole.log; fail "uninterrupted run"; }
+whole_s=$($py -c "import sys; print(max(1.0, float(sys.argv[2]) - float(sys.argv[1])))" "$start" "$(date +%s.%N)")
+[ "$(wc -l < whole/profile.csv)" -eq $((samples + 1)) ] || fail "uninterrupted profile has $(wc -l < whole/profile.csv) lines"
+check_whole whole
+echo "uninterrupted: $samples samples in $whole_s s"
+
+# 2. SIGKILL at random points, then --resume (a fixed seed: the same kill times every run).
+RANDOM=2026
+kills=0
+for attempt in $(seq 1 6); do
+  "$kerf" reference coarse.toml --samples $samples -o killed --resume > "killed.$attempt.log" 2>&1 &
+  pid=$!
+  if [ "$attempt" -lt 6 ]; then
+    # Attempts 1-2: a kill time uniform in [0.02, 0.42] x the uninterrupted wall time (mostly
+    # before any checkpoint). Attempts 3-5: once sample 6 is solved (past the checkpoint after
+    # sample 5), uniform in [0, 0.1] x it, while five samples are still to go: the kill lands
+    # and the next run resumes from the checkpoint.
+    if [ "$attempt" -le 2 ]; then
+      delay=$($py -c "import sys; print(float(sys.argv[1]) * (0.02 + 0.4 * int(sys.argv[2]) / 32767.0))" "$whole_s" "$RANDOM")
+    else
+      for _ in $(seq 1 6000); do
+        grep -Eq "sample ([6-9]|1[01])/$samples " "killed.$attempt.log" && break
+        kill -0 "$pid" 2> /dev/null || break
+        sleep 0.02
+      done
+      delay=$($py -c "import sys; print(float(sys.argv[1]) * 0.1 * int(sys.argv[2]) / 32767.0)" "$whole_s" "$RANDOM")
+    fi
+    sleep "$delay"
+    if kill -9 "$pid" 2> /dev/null; then
+      wait "$pid" 2> /dev/null || true
+      kills=$((kills + 1))
+      check_whole killed
+      continue
+    fi
+    # It finished before the kill (a fast machine): start again from nothing.
+    wait "$pid" || { cat "killed.$attempt.log"; fail "run $attempt failed"; }
+    rm -rf killed
+    continue
+  fi
+  wait "$pid" || { cat "killed.$attempt.log"; fail "resumed run $attempt failed"; }
+  break
+done
+[ "$kills" -ge 3 ] || fail "only $kills kills landed during a run: the test did not exercise resume"
+grep -q 'resum' killed.*.log || fail "no run resumed from a checkpoint"
+check_whole killed
+diff <(physics whole/profile.csv) <(physics killed/profile.csv) || fail "the resumed profile differs from the uninterrupted one"
+echo "SIGKILL: $kills kills, then --resume: the profile equals the uninterrupted one ($(find killed -name '*.tmp.*' | wc -l) temporary files left)"
+
+# 3. A full disk: RLIMIT_FSIZE per file (bash counts 1024-byte blocks) with SIGXFSZ ignored, so
+#    the first larger write fails with EFBIG as it would with ENOSPC. Two places: 64 kB with
+#    fields (the second .vtu, ~120 kB, fails at sample 2) and 12 kB without (the checkpoint,
+#    ~15 kB, fails at sample 5).
+for limit in "64 fields" "12 no-fields"; do
+  set -- $limit
+  kb=$1
+  flags=()
+  [ "$2" = "no-fields" ] && flags=(--no-fields)
+  dir="full_$kb"
+  set +e
+  ( trap '' XFSZ; ulimit -f "$kb"; exec "$kerf" reference coarse.toml --samples $samples "${flags[@]}" -o "$dir" ) > "$dir.log" 2>&1
+  rc=$?
+  set -e
+  [ "$rc" -ne 0 ] || { cat "$dir.log"; fail "a run past the $kb kB file-size limit succeeded"; }
+  [ "$rc" -lt 128 ] || { cat "$dir.log"; fail "the run died by signal $((rc - 128)) instead of failing with a message"; }
+  grep -Eiq 'writ|disk|space|too large|input/output' "$dir.log" || { cat "$dir.log"; fail "no message about the failed write"; }
+  check_whole "$dir"
+  echo "full disk at $kb kB ($2): exit $rc: $(grep -m1 -A12 'kerf: error' "$dir.log" | grep -v '^#' | tr -s '\n ' ' ' | cut -c1-160)"
+  "$kerf" reference coarse.toml --samples $samples "${flags[@]}" -o "$dir" --resume > "$dir.resume.log" 2>&1 \
+    || { cat "$dir.resume.log"; fail "resume after the full disk"; }
+  check_whole "$dir"
+  diff <(physics whole/profile.csv) <(physics "$dir/profile.csv") || fail "the profile after a full disk and --resume differs"
+  echo "  then --resume ($(grep -o -m1 'resuming after sample [0-9/]*\|no checkpoint' "$dir.resume.log")): the profile equals the uninterrupted one"
+done
+
+# 4. An absurd load increment: the stylus jumps 2 m up (the block is 20 mm deep) between the two
+#    samples solved.
+sed 's/^to = \["20 mm", "0 mm", "30 mm"\]/to = ["20 mm", "0 mm", "2 m"]/' coarse.toml > absurd.toml
+grep -q '"2 m"' absurd.toml || fail "clay_pull.toml has no pull target to exaggerate"
+set +e
+"$kerf" reference absurd.toml --samples 2 -o absurd > absurd.log 2>&1
+rc=$?
+set -e
+[ "$rc" -lt 128 ] || { cat absurd.log; fail "the absurd increment crashed the run (signal $((rc - 128)))"; }
+check_whole absurd
+$py - absurd <<'PY' || { cat absurd.log; fail "absurd increment"; }
+import json, math, os, re, sys
+d = sys.argv[1]
+m = json.load(open(os.path.join(d, "manifest.json")))
+rows = [l.split(",") for l in open(os.path.join(d, "profile.csv")).read().splitlines()[1:]]
+for r in rows:
+    assert all(math.isfinite(float(v)) for i, v in enumerate(r) if i not in (1, 8)), r
+if m.get("stopped"):
+    # Stopped: the converged samples kept, the reason in the manifest, the last state saved.
+    assert len(rows) == 1 and os.path.exists(os.path.join(d, "checkpoint.bin")), "stopped without the last state"
+    assert "cut-backs" in m["stopped"], m["stopped"]
+    print("absurd increment: stopped after %d converged sample(s), state saved: %s" % (len(rows), m["stopped"][:160]))
+else:
+    log = open(d + ".log").read()
+    cut = [int(w) for w in re.findall(r"(\d+) cut-backs", log)]
+    assert len(rows) == 2 and max(cut) > 0, "solved without a single cut-back: the increment was not absurd"
+    print("absurd increment: converged with %d cut-backs" % sum(cut))
+PY
+echo "reference faults: all passed"

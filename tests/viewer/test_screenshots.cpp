@@ -1,0 +1,213 @@
+// `kerf view ... --screenshot` under Xvfb (xvfb_display.cpp): pictures of runs (`kerf run`, then
+// `kerf view RUN_DIR --at T`) checked against what the scene says must be seen. Front camera
+// (parallel projection, x to the right, z up), no text, legend or chart, fixed colour scale, so a
+// pixel changes only where the body, a tool or a force changes. The image is mapped to world x
+// and z from the body's own silhouette at t = 0 (the block's known extent in the scene file),
+// never from the renderer's internals.
+
+#include "tests/viewer/png_image.hpp"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+using kerf::test::PngImage;
+
+namespace {
+
+std::filesystem::path scratch(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_viewer_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  return dir / name;
+}
+
+/// Runs kerf with `arguments`; returns its exit code and standard output.
+std::pair<int, std::string> run_kerf(const std::string& arguments) {
+  const std::string command = std::string(KERF_BINARY) + " " + arguments + " 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return {-1, ""};
+  std::string out;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), static_cast<int>(buffer.size()), pipe)) out += buffer.data();
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+/// World x [m] and z [m] of the block's silhouette in the t = 0 picture: its leftmost and
+/// rightmost foreground columns are x = 0 and x = length, its lowest foreground row is z = 0.
+struct ImageFrame {
+  int left = 0, right = 0, bottom = 0;
+  double pixels_per_metre = 0.0;
+  [[nodiscard]] int column(double x) const { return left + static_cast<int>(std::lround(x * pixels_per_metre)); }
+  [[nodiscard]] int row(double z) const { return bottom + static_cast<int>(std::lround(z * pixels_per_metre)); }
+  [[nodiscard]] double x(int column) const { return (column - left) / pixels_per_metre; }
+};
+
+ImageFrame locate_block(const PngImage& rest, double length) {
+  ImageFrame f;
+  f.left = rest.width;
+  f.right = -1;
+  f.bottom = rest.height;
+  for (int y = 0; y < rest.height; ++y)
+    for (int x = 0; x < rest.width; ++x)
+      if (rest.foreground(x, y)) {
+        f.left = std::min(f.left, x);
+        f.right = std::max(f.right, x);
+        f.bottom = std::min(f.bottom, y);
+      }
+  f.pixels_per_metre = (f.right - f.left) / length;
+  return f;
+}
+
+const std::string picture = " --camera front --no-text --no-chart --width 800 --height 600";
+
+} // namespace
+
+// clay_pull (experiments/scenes/clay_pull.toml): a 40 x 40 x 20 mm block, the stylus pulls the
+// top centre (x = 20 mm) up 8 mm in 1.6 s. The spring network is built around the stylus only
+// (8 cells of 2.5 mm: x in [10, 30] mm, spring_network_model.hpp) and fine nodes outside it keep
+// their rest positions (paper 000 §2.1, network_embedding.hpp): outside the network, widened by
+// one element (2.5 mm, the scene's element size) whose colour interpolates from a moved node,
+// nothing may change; above the pulled surface, the body and the moved stylus must.
+TEST(ViewerScreenshot, ClayPullChangesOnlyWhereTheBodyDeforms) {
+  const auto run = scratch("clay_pull_springs");
+  auto [code, out] = run_kerf("run clay_pull --model springs -o " + run.string());
+  ASSERT_EQ(code, 0) << out;
+  const auto before = scratch("clay_pull_0.png"), after = scratch("clay_pull_1.6.png");
+  const std::string common = "view " + run.string() + " --colour-max \"8 mm\"" + picture;
+  auto [code0, out0] = run_kerf(common + " --screenshot " + before.string() + " --at 0");
+  ASSERT_EQ(code0, 0) << out0;
+  auto [code1, out1] = run_kerf(common + " --screenshot " + after.string() + " --at 1.6");
+  ASSERT_EQ(code1, 0) << out1;
+  const PngImage a = PngImage::read(before), b = PngImage::read(after);
+  ASSERT_EQ(a.width, b.width);
+  ASSERT_EQ(a.height, b.height);
+
+  const ImageFrame f = locate_block(a, 0.040);
+  ASSERT_GT(f.pixels_per_metre, 5000.0) << "the block should span a good part of the 800 px picture";
+  // The silhouette's height is the block's 20 mm (a parallel front projection, square pixels).
+  int top = f.bottom;
+  for (int y = f.bottom; y < a.height; ++y)
+    if (a.foreground(f.column(0.005), y)) top = y;
+  EXPECT_NEAR((top - f.bottom + 1) / f.pixels_per_metre, 0.020, 2.0 / f.pixels_per_metre + 1e-4);
+
+  // Elsewhere: every pixel left of x = 7 mm and right of x = 33 mm, body and background alike.
+  long elsewhere = 0, changed_elsewhere = 0;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      const double wx = f.x(x);
+      if (wx < 0.007 || wx > 0.033) {
+        ++elsewhere;
+        if (a.difference(b, x, y) != 0) ++changed_elsewhere;
+      }
+    }
+  EXPECT_GT(elsewhere, 100000);
+  EXPECT_EQ(changed_elsewhere, 0) << "pixels changed away from the deformed region";
+
+  // The deformed region: where the surface under the stylus was pulled up, above the rest top
+  // (z = 20 mm) between x = 15 and 25 mm. (The block's front face, y = -20 mm, lies outside the
+  // network, which spans y in [-10, 10] mm, so it rightly does not change.)
+  long region = 0, changed = 0;
+  for (int y = f.row(0.0205); y <= f.row(0.029); ++y)
+    for (int x = f.column(0.015); x <= f.column(0.025); ++x) {
+      ++region;
+      if (a.difference(b, x, y) > 8) ++changed;
+    }
+  EXPECT_GT(changed, region / 2) << changed << " of " << region << " pixels changed above the pulled surface";
+  // And the body's top follows the stylus: at x = 20 mm (just beside the tool's axis the sphere
+  // does not cover) foreground reaches well above the rest top (z = 20 mm) at 1.6 s.
+  int rest_top = 0, pulled_top = 0;
+  const int column = f.column(0.0175);
+  for (int y = 0; y < a.height; ++y) {
+    if (a.foreground(column, y)) rest_top = y;
+    if (b.foreground(column, y)) pulled_top = y;
+  }
+  EXPECT_GT(pulled_top - rest_top, static_cast<int>(0.002 * f.pixels_per_metre));
+}
+
+// clay_tear (experiments/scenes/clay_tear.toml): a 60 x 20 x 20 mm block pulled apart at x = 15
+// and 45 mm by 10 mm each; the network (8 cells of 7.5 mm) tears where the tensile stress passes
+// the cohesive strength, the expected tear surface being the mid-plane x = 30 mm. Fragments along
+// the pulling direction: the picture's columns that hold foreground within the block's height
+// (z in [1, 19] mm), in runs. At rest one run; torn and pulled apart two, separated by a gap of
+// empty columns that lies on the tear line to within one network cell (7.5 mm).
+TEST(ViewerScreenshot, TornClayShowsTwoFragmentsAlongTheTearLine) {
+  const auto run = scratch("clay_tear_springs");
+  auto [code, out] = run_kerf("run clay_tear --model springs -o " + run.string());
+  ASSERT_EQ(code, 0) << out;
+  {
+    // The model marks the sample at which a tear separates the network "rupture" (springs model);
+    // without a tear there are no fragments to see.
+    std::ifstream profile(run / "profile.csv");
+    const std::string text((std::istreambuf_iterator<char>(profile)), std::istreambuf_iterator<char>());
+    if (text.find(",rupture,") == std::string::npos) GTEST_SKIP() << "the springs model did not tear clay_tear";
+  }
+  const auto before = scratch("clay_tear_0.png"), after = scratch("clay_tear_end.png");
+  const std::string common = "view " + run.string() + picture;
+  auto [code0, out0] = run_kerf(common + " --screenshot " + before.string() + " --at 0");
+  ASSERT_EQ(code0, 0) << out0;
+  auto [code1, out1] = run_kerf(common + " --screenshot " + after.string() + " --at 3");
+  ASSERT_EQ(code1, 0) << out1;
+  const PngImage a = PngImage::read(before), b = PngImage::read(after);
+  const ImageFrame f = locate_block(a, 0.060);
+  ASSERT_GT(f.pixels_per_metre, 5000.0);
+  auto fragments = [&](const PngImage& image, std::vector<std::pair<int, int>>* runs) {
+    std::vector<bool> occupied(static_cast<std::size_t>(image.width), false);
+    for (int x = 0; x < image.width; ++x)
+      for (int y = f.row(0.001); y <= f.row(0.019); ++y)
+        if (image.foreground(x, y)) occupied[static_cast<std::size_t>(x)] = true;
+    int count = 0;
+    for (int x = 0; x < image.width; ++x)
+      if (occupied[static_cast<std::size_t>(x)] && (x == 0 || !occupied[static_cast<std::size_t>(x - 1)])) {
+        ++count;
+        int end = x;
+        while (end + 1 < image.width && occupied[static_cast<std::size_t>(end + 1)]) ++end;
+        if (runs) runs->emplace_back(x, end);
+      }
+    return count;
+  };
+  EXPECT_EQ(fragments(a, nullptr), 1);
+  std::vector<std::pair<int, int>> runs;
+  ASSERT_EQ(fragments(b, &runs), 2) << "the torn block should show two fragments";
+  const double gap_centre = f.x((runs[0].second + runs[1].first) / 2);
+  EXPECT_NEAR(gap_centre, 0.030, 0.0075) << "the gap should lie on the tear line x = 30 mm";
+}
+
+// kerf view RUN RUN: the same run side by side must give the same picture in both halves (one
+// camera, one colour scale) up to rasterisation at the silhouette; a run re-stepped from its profile's samples (one that wrote no
+// series of its own) must reproduce its recorded forces exactly (the models are deterministic).
+TEST(ViewerScreenshot, SameRunSideBySideGivesIdenticalHalves) {
+  const auto run = scratch("run_clay_pull");
+  auto [code, out] = run_kerf("run clay_pull --model springs -o " + run.string());
+  ASSERT_EQ(code, 0) << out;
+  const auto shot = scratch("side_by_side.png");
+  auto [code1, out1] = run_kerf("view " + run.string() + " " + run.string() +
+                            " --no-text --camera front --width 1000 --height 600 --at 1.6 --screenshot " + shot.string());
+  ASSERT_EQ(code1, 0) << out1;
+  if (out1.find("re-stepped") != std::string::npos) {
+    EXPECT_NE(out1.find("differs from the recorded profile by at most 0 N"), std::string::npos) << out1;
+  }
+  const PngImage image = PngImage::read(shot);
+  const int half = image.width / 2;
+  long foreground = 0, different = 0;
+  // The body views fill the top 70% (the chart strip is below); compare the two halves there.
+  for (int y = static_cast<int>(0.3 * image.height) + 1; y < image.height; ++y)
+    for (int x = 0; x < half; ++x) {
+      if (image.foreground(x, y)) ++foreground;
+      const std::uint8_t* l = image.at(x, y);
+      const std::uint8_t* r = image.at(x + half, y);
+      if (l[0] != r[0] || l[1] != r[1] || l[2] != r[2]) ++different;
+    }
+  EXPECT_GT(foreground, 10000);
+  // Identical up to edge pixels: Mesa's rasteriser snaps to the window's pixel grid, and the two
+  // viewports sit at different window offsets, so a few silhouette pixels may fall differently.
+  EXPECT_LT(different, foreground / 200) << different << " of " << foreground << " foreground pixels differ";
+}

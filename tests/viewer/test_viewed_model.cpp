@@ -1,0 +1,138 @@
+// ViewedModel and the model adapters, without rendering: a snapshot holds exactly the model's
+// state at the step it was taken after; the render side's geometry follows the paper's rules
+// (paper 000 §2.1: fine nodes outside the spring network stay at rest, fine nodes on network
+// nodes move with them); a .pvd series reads back what kerf's own writer wrote.
+
+#include "experiments/run/model_catalogue.hpp"
+#include "experiments/run/run_model.hpp"
+#include "experiments/run/scene_mesh.hpp"
+#include "experiments/scene/scene_reader.hpp"
+#include "meshes/vtu_writer.hpp"
+#include "viewer/offline_stepping.hpp"
+#include "viewer/pvd_series.hpp"
+#include "viewer/springs_adapter.hpp"
+#include "tests/realtime/springs/model_fixtures.hpp"
+#include "viewer/viewed_model.hpp"
+
+#include <gtest/gtest.h>
+#include <vtkDataSet.h>
+
+#include <fstream>
+#include <unistd.h>
+
+using namespace kerf;
+
+/// clay_pull's spring network (tests/realtime/springs/model_fixtures.hpp: the scene's material,
+/// support and stylus on a box mesh) and the scene's own trajectory.
+struct ClayPull {
+  TetMesh mesh = test::clay_pull_mesh();
+  SpringNetworkModel model{mesh, test::clay_pull_setup(SpringIntegrator::symplectic_euler)};
+  std::vector<SampledTrajectory> trajectory =
+      sample_scene_trajectories(read_scene(std::string(KERF_SCENES_DIR) + "/clay_pull.toml"));
+};
+
+// The frame taken after a step is that step: network positions, forces and tool positions equal
+// the model's own; the reader always gets the newest frame.
+TEST(ViewedModel, SnapshotIsTheModelStateAfterTheStep) {
+  ClayPull c;
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(c.model, c.mesh);
+  ViewedModel viewed(c.model, *adapter, 1.0 / 60.0);
+  const std::vector<SampledTrajectory>& t = c.trajectory;
+  std::vector<ForceSample> forces(1);
+  const double dt = 1.0 / t[0].rate;
+  std::uint64_t taken = 0;
+  for (std::size_t k = 0; k < 400; ++k) {
+    viewed.step(std::span(&t[0].samples[k], 1), dt, forces);
+    if (viewed.update()) {
+      ++taken;
+      const ViewFrame& f = viewed.frame();
+      EXPECT_EQ(f.sequence, viewed.frames_published());
+      EXPECT_EQ(f.time, t[0].samples[k].time);
+      EXPECT_EQ(f.tool_position[0], t[0].samples[k].position);
+      EXPECT_EQ(f.force[0].force, forces[0].force);
+      const int n = c.model.network().node_count;
+      ASSERT_EQ(f.model.point_count, n);
+      EXPECT_EQ(Eigen::Matrix3Xd(f.model.points.leftCols(n)), Eigen::Matrix3Xd(c.model.positions().leftCols(n)));
+    }
+  }
+  // One frame per 1/60 s of model time: 400 ms at 1 kHz gives one every 17 ms (the first step
+  // publishes at once), 24 in all.
+  EXPECT_EQ(taken, 24u);
+}
+
+// Paper 000 §2.1: the fine mesh follows the network by interpolation inside the network's cells
+// and keeps its rest position outside them; a fine node at a network node's rest position moves
+// exactly with that node (the Coons interpolant reproduces its nodes).
+TEST(SpringsAdapter, FineMeshFollowsTheNetworkInsideAndRestsOutside) {
+  ClayPull c;
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(c.model, c.mesh);
+  ViewedModel viewed(c.model, *adapter, 1.0);
+  const std::array<double, 1> times{1.6};
+  BodyGeometry g;
+  step_through(viewed, c.trajectory, times, [&](const ViewFrame& f) { adapter->geometry(f, g); });
+  const SpringNetwork& net = c.model.network();
+  const Eigen::Vector3d lo = net.block.origin;
+  const Eigen::Vector3d hi = lo + net.block.cell_size * net.block.cells.cast<double>();
+  int outside = 0, on_nodes = 0;
+  double largest = 0.0;
+  for (Eigen::Index i = 0; i < g.rest.rows(); ++i) {
+    const Eigen::Vector3d X = g.rest.row(i).transpose();
+    const Eigen::Vector3d u = (g.points.row(i) - g.rest.row(i)).transpose();
+    largest = std::max(largest, u.norm());
+    if ((X.array() < lo.array() - 1e-9).any() || (X.array() > hi.array() + 1e-9).any()) {
+      ++outside;
+      EXPECT_EQ(u.norm(), 0.0) << "fine node " << i << " outside the network moved";
+      continue;
+    }
+    for (int n = 0; n < net.node_count; ++n)
+      if ((net.rest.col(n) - X).norm() < 1e-12) {
+        ++on_nodes;
+        EXPECT_LT((g.points.row(i).transpose() - c.model.positions().col(n)).norm(), 1e-12);
+      }
+  }
+  EXPECT_GT(outside, 20);
+  EXPECT_GT(on_nodes, 10);
+  // The stylus pulled 8 mm: the body moved, by no more than the stylus did.
+  EXPECT_GT(largest, 1e-3);
+  EXPECT_LT(largest, 8e-3 + 1e-4);
+}
+
+// A .pvd written like the reference's (kerf's VTU writer, a displacement field, steps listed
+// out of order) reads back sorted, with points moved by exactly the displacement.
+TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {
+  const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_pvd_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir / "fields");
+  TetMesh mesh;
+  mesh.nodes.resize(4, 3);
+  mesh.nodes << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  mesh.tets.resize(1, 4);
+  mesh.tets << 0, 1, 2, 3;
+  mesh.volume_groups.push_back({"body", 1, {0}});
+  for (int k = 0; k < 2; ++k) {
+    Eigen::MatrixXd u = Eigen::MatrixXd::Zero(4, 3);
+    u.col(2).setConstant(0.5 * k);
+    write_vtu(mesh, dir / "fields" / ("step_" + std::to_string(k) + ".vtu"), {{"displacement", u}});
+  }
+  {
+    std::ofstream pvd(dir / "fields.pvd");
+    pvd << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n"
+           "<DataSet timestep=\"2.5\" file=\"fields/step_1.vtu\"/>\n<DataSet timestep=\"0\" file=\"fields/step_0.vtu\"/>\n"
+           "</Collection>\n</VTKFile>\n";
+  }
+  PvdSeries series(dir / "fields.pvd");
+  ASSERT_EQ(series.times().size(), 2u);
+  EXPECT_EQ(series.times()[0], 0.0);
+  EXPECT_EQ(series.times()[1], 2.5);
+  EXPECT_EQ(series.step_at(-1.0), 0u);
+  EXPECT_EQ(series.step_at(2.4), 0u);
+  EXPECT_EQ(series.step_at(2.5), 1u);
+  vtkDataSet* moved = series.deformed(1);
+  ASSERT_EQ(moved->GetNumberOfPoints(), 4);
+  for (vtkIdType i = 0; i < 4; ++i) {
+    double p[3];
+    moved->GetPoint(i, p);
+    EXPECT_DOUBLE_EQ(p[2], mesh.nodes(i, 2) + 0.5);
+  }
+  EXPECT_THROW(PvdSeries(dir / "missing.pvd"), std::runtime_error);
+  std::filesystem::remove_all(dir);
+}

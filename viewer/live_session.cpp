@@ -1,0 +1,95 @@
+#include "viewer/live_session.hpp"
+
+#include "viewer/viewed_model.hpp"
+
+#include <chrono>
+#include <stdexcept>
+#include <thread>
+
+namespace kerf {
+
+LiveViewReport run_live_view(ToolModel& model, const TetMesh& mesh, std::span<HapticDevice* const> devices,
+                             const LiveViewSettings& settings, std::atomic<ServoLoop*>* running) {
+  if (!(settings.display_rate > 0.0 && settings.display_rate <= 240.0))
+    throw std::invalid_argument("viewer: display rate must be in (0, 240] Hz, got " + std::to_string(settings.display_rate));
+  LiveViewReport out;
+  if (!settings.view) {
+    ServoLoop loop(model, devices, settings.servo, nullptr);
+    if (running) running->store(&loop);
+    out.servo = loop.run();
+    if (running) running->store(nullptr);
+    return out;
+  }
+
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(model, mesh);
+  ViewedModel viewed(model, *adapter, 1.0 / settings.display_rate);
+  ViewWindowSettings window_settings = settings.window;
+  window_settings.offscreen = !settings.interactive;
+  ViewWindow window(window_settings, 1, false);
+  FrameView view(window.body_renderer(0), *adapter, settings.frame);
+  frame_camera(window.camera(), view.bounds(), settings.camera, window.body_aspect());
+
+  ServoLoop loop(viewed, devices, settings.servo, nullptr);
+  // The servo statistics are read in the thread that steps the model: only when that is the
+  // servo thread itself (single-rate) are they the servo's own, race-free.
+  if (settings.servo.model_rate <= 0.0) viewed.set_servo_timing(&loop.timing());
+  if (running) running->store(&loop);
+  std::atomic<bool> done{false};
+  std::thread servo([&] {
+    out.servo = loop.run();
+    done.store(true, std::memory_order_release);
+  });
+
+  using Clock = std::chrono::steady_clock;
+  double render_total = 0.0;
+  auto draw = [&] {
+    if (!viewed.update()) return;
+    const auto begin = Clock::now();
+    view.show(viewed.frame());
+    window.render();
+    const double seconds = std::chrono::duration<double>(Clock::now() - begin).count();
+    render_total += seconds;
+    out.max_render_seconds = std::max(out.max_render_seconds, seconds);
+    ++out.frames_rendered;
+  };
+  const double period = 1.0 / settings.display_rate;
+  try {
+    if (settings.interactive) {
+      window.run(
+          [&] {
+            draw();
+            return !done.load(std::memory_order_acquire);
+          },
+          period,
+          [&](const std::string& key) {
+            if (key == "o") view.toggle_overlay();
+          });
+      loop.request_stop(); // the window was closed (or q): end the session with a ramp out
+    } else {
+      auto next = Clock::now();
+      while (!done.load(std::memory_order_acquire)) {
+        next += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period));
+        std::this_thread::sleep_until(next);
+        draw();
+      }
+    }
+  } catch (...) {
+    loop.request_emergency_stop();
+    servo.join();
+    if (running) running->store(nullptr);
+    throw;
+  }
+  servo.join();
+  if (running) running->store(nullptr);
+  draw(); // the last frame published
+  if (!settings.screenshot.empty()) {
+    view.show(viewed.frame());
+    window.write_png(settings.screenshot);
+  }
+  out.frames_published = viewed.frames_published();
+  out.max_capture_seconds = viewed.max_capture_seconds();
+  out.mean_render_seconds = out.frames_rendered ? render_total / static_cast<double>(out.frames_rendered) : 0.0;
+  return out;
+}
+
+} // namespace kerf
