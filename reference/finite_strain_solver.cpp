@@ -507,6 +507,8 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   const bool direct = settings.linear_solver == LinearSolverChoice::direct ||
                       (settings.linear_solver == LinearSolverChoice::automatic && dof.n_dofs() <= settings.direct_dof_limit);
   const auto kind = direct ? TangentSolver::Kind::direct : TangentSolver::Kind::iterative;
+  // Contact and a softening cohesive interface make the tangent indefinite: GMRES instead of CG.
+  const bool spd = !tool && !cohesive_law;
   if (!distributed) {
     dealii::AffineConstraints<double> structure;
     for (const auto& d : dirichlet) structure.add_line(d.index);
@@ -524,7 +526,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     serial.free_mask.reinit(dof.n_dofs());
     serial.free_mask = 1.0;
     for (const auto& d : dirichlet) serial.free_mask[d.index] = 0.0;
-    linear = std::make_unique<TangentSolver>(kind, std::move(support), settings.iterative_tolerance);
+    linear = std::make_unique<TangentSolver>(kind, std::move(support), settings.iterative_tolerance, false, spd);
     return;
   }
   // Distributed: this process's rows (locally owned DOFs) and the DOFs its cells touch
@@ -553,7 +555,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   la.free_mask.compress(dealii::VectorOperation::insert);
   std::vector<dealii::Point<3>> owned_support;
   for (const auto i : la.owned) owned_support.push_back(support[i]);
-  linear = std::make_unique<TangentSolver>(kind, std::move(owned_support), settings.iterative_tolerance, true);
+  linear = std::make_unique<TangentSolver>(kind, std::move(owned_support), settings.iterative_tolerance, true, spd);
 }
 
 template <class Algebra>

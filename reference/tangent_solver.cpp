@@ -18,8 +18,16 @@ void check(PetscErrorCode code, const char* what) {
 }
 
 /// CG on the true residual, preconditioned by GAMG (the near null space is set on the matrix).
-void configure_cg_gamg(KSP ksp, double tolerance) {
-  check(KSPSetType(ksp, KSPCG), "KSPSetType");
+/// CG (SPD tangents) or GMRES (indefinite ones: right-preconditioned, so that its residual is the
+/// true one; restart 200) with GAMG, stopping at a true residual of `tolerance` |b|.
+void configure_krylov_gamg(KSP ksp, double tolerance, bool spd) {
+  if (spd) {
+    check(KSPSetType(ksp, KSPCG), "KSPSetType");
+  } else {
+    check(KSPSetType(ksp, KSPGMRES), "KSPSetType");
+    check(KSPGMRESSetRestart(ksp, 200), "KSPGMRESSetRestart");
+    check(KSPSetPCSide(ksp, PC_RIGHT), "KSPSetPCSide");
+  }
   check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
   check(KSPSetTolerances(ksp, tolerance, 1e-300, PETSC_DEFAULT, 5000), "KSPSetTolerances");
   PC pc = nullptr;
@@ -73,13 +81,14 @@ struct TangentSolver::Petsc {
   }
 };
 
-TangentSolver::TangentSolver(Kind kind, std::vector<dealii::Point<3>> coordinates, double tol, bool distributed)
-    : m_kind(kind), m_coordinates(std::move(coordinates)), m_tolerance(tol), m_distributed(distributed) {}
+TangentSolver::TangentSolver(Kind kind, std::vector<dealii::Point<3>> coordinates, double tol, bool distributed,
+                             bool spd)
+    : m_kind(kind), m_coordinates(std::move(coordinates)), m_tolerance(tol), m_distributed(distributed), m_spd(spd) {}
 
 TangentSolver::~TangentSolver() = default;
 
 std::string TangentSolver::name() const {
-  if (m_kind == Kind::iterative) return "petsc-cg-gamg";
+  if (m_kind == Kind::iterative) return m_spd ? "petsc-cg-gamg" : "petsc-gmres-gamg";
   return m_distributed ? "mumps" : "umfpack";
 }
 
@@ -103,7 +112,7 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
     check(MatSetOption(m_petsc->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
     check(MatCreateVecs(m_petsc->A, &m_petsc->x, &m_petsc->b), "MatCreateVecs");
     check(KSPCreate(PETSC_COMM_SELF, &m_petsc->ksp), "KSPCreate");
-    configure_cg_gamg(m_petsc->ksp, m_tolerance);
+    configure_krylov_gamg(m_petsc->ksp, m_tolerance, m_spd);
   }
   // Copy the values row by row (PETSc sorts the columns).
   check(MatZeroEntries(m_petsc->A), "MatZeroEntries");
@@ -130,7 +139,7 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
   for (PetscInt i = 0; i < n; ++i) pb[i] = b[static_cast<std::size_t>(i)];
   check(VecRestoreArray(m_petsc->b, &pb), "VecRestoreArray");
   check(VecSet(m_petsc->x, 0.0), "VecSet");
-  const int iterations = run_ksp(m_petsc->ksp, m_petsc->b, m_petsc->x, "PETSc CG + GAMG");
+  const int iterations = run_ksp(m_petsc->ksp, m_petsc->b, m_petsc->x, m_spd ? "PETSc CG + GAMG" : "PETSc GMRES + GAMG");
   const PetscScalar* px = nullptr;
   check(VecGetArrayRead(m_petsc->x, &px), "VecGetArrayRead");
   for (PetscInt i = 0; i < n; ++i) x[static_cast<std::size_t>(i)] = px[i];
@@ -174,7 +183,7 @@ int TangentSolver::solve(const dealii::PETScWrappers::MPI::SparseMatrix& K, deal
       check(MatMPIAIJSetPreallocation(m_petsc->A, 0, diagonal.data(), 0, off.data()), "MatMPIAIJSetPreallocation");
       check(MatSeqAIJSetPreallocation(m_petsc->A, 0, diagonal.data()), "MatSeqAIJSetPreallocation");
       check(MatSetOption(m_petsc->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
-      configure_cg_gamg(m_petsc->ksp, m_tolerance);
+      configure_krylov_gamg(m_petsc->ksp, m_tolerance, m_spd);
     }
   }
   if (m_kind == Kind::iterative) {
@@ -201,7 +210,7 @@ int TangentSolver::solve(const dealii::PETScWrappers::MPI::SparseMatrix& K, deal
     run_ksp(m_petsc->ksp, static_cast<const Vec&>(b), xv, "MUMPS");
     return 0;
   }
-  return run_ksp(m_petsc->ksp, static_cast<const Vec&>(b), xv, "PETSc CG + GAMG");
+  return run_ksp(m_petsc->ksp, static_cast<const Vec&>(b), xv, m_spd ? "PETSc CG + GAMG" : "PETSc GMRES + GAMG");
 }
 
 } // namespace kerf::reference

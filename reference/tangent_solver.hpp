@@ -1,8 +1,10 @@
 #pragma once
 // TangentSolver: solves one Newton step's linear system K du = b — UMFPACK for small systems,
-// PETSc CG preconditioned by GAMG with elasticity's six rigid-body modes as near null space for
-// large ones (../shared/notes/dealii-on-debian12.md: without them AMG loses to Jacobi). The CG stop
-// test uses the unpreconditioned (true) residual, which Newton's convergence depends on.
+// PETSc CG (or GMRES) preconditioned by GAMG with elasticity's six rigid-body modes as near null
+// space for large ones (../shared/notes/dealii-on-debian12.md: without them AMG loses to Jacobi).
+// CG needs a symmetric positive definite tangent; contact (the penalty term ε_N p ∂n/∂x) and a
+// softening cohesive interface make it indefinite, and then GMRES (right-preconditioned) is used.
+// The stop test uses the unpreconditioned (true) residual, which Newton's convergence depends on.
 // Distributed over MPI processes (PETSc MPI matrix and vectors): MUMPS is the direct solver (a
 // parallel LU), CG + GAMG the iterative one, both on the matrix's communicator.
 // Internal to reference/: includes deal.II, never included outside this folder.
@@ -27,8 +29,10 @@ public:
   /// the x, y, z components of one node), used for the rigid-body modes of the iterative solver.
   /// `distributed`: the systems are PETSc MPI ones (the second `solve`); `coordinates` are then
   /// the support points of this process's locally owned DOFs, in their global order.
+  /// `symmetric_positive_definite`: the tangents are SPD (CG); false: they may be indefinite or
+  /// unsymmetric (GMRES).
   TangentSolver(Kind kind, std::vector<dealii::Point<3>> coordinates, double relative_tolerance,
-                bool distributed = false);
+                bool distributed = false, bool symmetric_positive_definite = true);
   ~TangentSolver();
   TangentSolver(const TangentSolver&) = delete;
   TangentSolver& operator=(const TangentSolver&) = delete;
@@ -41,7 +45,7 @@ public:
   int solve(const dealii::PETScWrappers::MPI::SparseMatrix& K, dealii::PETScWrappers::MPI::Vector& x,
             const dealii::PETScWrappers::MPI::Vector& b);
   [[nodiscard]] Kind kind() const { return m_kind; }
-  /// "umfpack" / "mumps" (direct, serial / distributed) or "petsc-cg-gamg".
+  /// "umfpack" / "mumps" (direct, serial / distributed), "petsc-cg-gamg" or "petsc-gmres-gamg".
   [[nodiscard]] std::string name() const;
 
 private:
@@ -51,6 +55,7 @@ private:
   double m_tolerance;
   std::unique_ptr<Petsc> m_petsc;
   bool m_distributed;
+  bool m_spd;
 };
 
 } // namespace kerf::reference

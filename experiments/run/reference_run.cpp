@@ -48,10 +48,75 @@ Eigen::Vector3d position_at(const std::vector<Eigen::Vector3d>& p, const std::ve
 
 } // namespace
 
+namespace {
+
+/// If the sphere `tool` (sampled at `positions`) starts touching the body, moves, and never moves
+/// towards it (it pulls away, or drags the surface along), ties it (paper 000 §2.1: it grasps the surface): adds the tie group `tie_name` of the `top`
+/// triangles under it and the prescribed displacement u = p(λ T) − p(0) (the tool displacement
+/// since contact, λ the load factor) to `p`, and returns the coupling. Otherwise returns nothing.
+std::optional<ReferenceToolCoupling> tie_stylus(const Scene& scene, const TetMesh& mesh, const Tool& tool,
+                                                const std::vector<Eigen::Vector3d>& positions,
+                                                const std::vector<double>& times, const std::string& tie_name,
+                                                FiniteStrainProblem& p) {
+  const SurfaceQuery surface(boundary_surface(mesh));
+  const SurfaceQuery::Closest first = surface.closest_point(positions.front());
+  const Eigen::Vector3d away = first.normal;
+  const bool touching = std::abs(first.signed_distance - tool.radius) <= 0.05 * tool.radius;
+  // It moves (away from the surface, or along it: clay_tear drags the top apart), never into it.
+  double travel = 0.0, inward = 0.0;
+  for (const Eigen::Vector3d& x : positions) {
+    travel = std::max(travel, (x - positions.front()).norm());
+    inward = std::max(inward, -(x - positions.front()).dot(away));
+  }
+  if (!(touching && travel > 0.0 && inward <= 1e-9 * travel)) return std::nullopt;
+
+  ReferenceToolCoupling c;
+  c.kind = ReferenceToolCoupling::Kind::tied;
+  c.contact_point = first.point;
+  const SurfaceGroup* top = mesh.find_surface_group("top");
+  if (top == nullptr)
+    throw std::invalid_argument("reference: scene '" + scene.name + "': the tied stylus '" + tool.name +
+                                "' needs a surface group 'top'");
+  auto within = [&](int node) { return (Eigen::Vector3d(mesh.nodes.row(node)) - c.contact_point).norm() <= tool.radius; };
+  for (int pass = 0; pass < 2 && c.tied_triangles.empty(); ++pass)
+    for (Eigen::Index f = 0; f < top->triangles.rows(); ++f) {
+      int inside = 0;
+      for (int k = 0; k < 3; ++k) inside += within(top->triangles(f, k)) ? 1 : 0;
+      if (pass == 0 ? inside == 3 : inside > 0) c.tied_triangles.push_back(static_cast<int>(f));
+    }
+  if (c.tied_triangles.empty())
+    throw std::invalid_argument("reference: scene '" + scene.name + "': no node of 'top' lies within the radius of stylus '" +
+                                tool.name + "' of its first contact point");
+  SurfaceGroup tie;
+  tie.name = tie_name;
+  tie.triangles.resize(static_cast<Eigen::Index>(c.tied_triangles.size()), 3);
+  std::set<int> nodes;
+  for (std::size_t i = 0; i < c.tied_triangles.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      tie.triangles(static_cast<Eigen::Index>(i), k) = top->triangles(c.tied_triangles[i], k);
+      nodes.insert(top->triangles(c.tied_triangles[i], k));
+    }
+  c.tied_nodes = nodes.size();
+  p.mesh.surface_groups.push_back(std::move(tie));
+
+  // u = p(λ T) − p(0): the tool displacement since contact, λ the load factor.
+  auto path = std::make_shared<const std::vector<Eigen::Vector3d>>(positions);
+  auto at = std::make_shared<const std::vector<double>>(times);
+  const double T = times.back();
+  c.boundary = static_cast<int>(p.displacement_boundaries.size());
+  p.displacement_boundaries.push_back(
+      {tie_name, DisplacementBoundary::Kind::prescribed,
+       [path, at, T](const Eigen::Vector3d&, double load) -> Eigen::Vector3d {
+         return position_at(*path, *at, load * T) - path->front();
+       },
+       {true, true, true}});
+  return c;
+}
+
+} // namespace
+
 ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh) {
-  if (scene.tools.size() != 1)
-    throw std::invalid_argument("reference: scene '" + scene.name + "' has " + std::to_string(scene.tools.size()) +
-                                " tools; the reference couples exactly one rigid tool");
+  if (scene.tools.empty()) throw std::invalid_argument("reference: scene '" + scene.name + "' has no tool");
   ReferenceProblem out;
   FiniteStrainProblem& p = out.problem;
   p.mesh = mesh;
@@ -67,83 +132,64 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh) {
                                          {},
                                          {true, true, true}});
 
-  const Tool& tool = scene.tools.front();
-  const SampledTrajectory path = sample(tool.trajectory);
-  if (path.samples.empty()) throw std::invalid_argument("reference: tool '" + tool.name + "' has an empty trajectory");
-  for (const ToolState& s : path.samples) {
-    out.positions.push_back(s.position);
-    out.times.push_back(s.time);
-  }
-
-  reference::RigidToolShape shape;
-  if (tool.kind == Tool::Kind::blade) {
-    shape.kind = reference::RigidToolShape::Kind::wedge;
-    shape.edge_direction = tool.blade.edge_direction;
-    shape.cutting_direction = tool.blade.cutting_direction;
-    shape.wedge_angle = tool.blade.wedge_angle;
-    shape.thickness = tool.blade.thickness;
-    shape.edge_length = tool.blade.edge_length;
-    p.tool = shape;
-    return out;
-  }
-  shape.kind = reference::RigidToolShape::Kind::sphere;
-  shape.radius = tool.radius;
-
-  // A sphere that starts touching the body (centre one radius from the surface, within 5% of R)
-  // and never moves towards it grasps the surface (paper 000 §2.1): tied. Otherwise it presses.
-  const SurfaceQuery surface(boundary_surface(mesh));
-  const SurfaceQuery::Closest first = surface.closest_point(out.positions.front());
-  const Eigen::Vector3d away = first.normal;
-  const bool touching = std::abs(first.signed_distance - tool.radius) <= 0.05 * tool.radius;
-  double outward = 0.0, inward = 0.0;
-  for (const Eigen::Vector3d& x : out.positions) {
-    const double s = (x - out.positions.front()).dot(away);
-    outward = std::max(outward, s);
-    inward = std::max(inward, -s);
-  }
-  if (!(touching && outward > 0.0 && inward <= 1e-9 * outward)) {
-    p.tool = shape;
-    return out;
-  }
-
-  ReferenceToolCoupling& c = out.coupling;
-  c.kind = ReferenceToolCoupling::Kind::tied;
-  c.contact_point = first.point;
-  const SurfaceGroup* top = mesh.find_surface_group("top");
-  if (top == nullptr)
-    throw std::invalid_argument("reference: scene '" + scene.name + "': the tied stylus needs a surface group 'top'");
-  auto within = [&](int node) { return (Eigen::Vector3d(mesh.nodes.row(node)) - c.contact_point).norm() <= tool.radius; };
-  for (int pass = 0; pass < 2 && c.tied_triangles.empty(); ++pass)
-    for (Eigen::Index f = 0; f < top->triangles.rows(); ++f) {
-      int inside = 0;
-      for (int k = 0; k < 3; ++k) inside += within(top->triangles(f, k)) ? 1 : 0;
-      if (pass == 0 ? inside == 3 : inside > 0) c.tied_triangles.push_back(static_cast<int>(f));
+  // Every tool on one time line (the load factor of sample k is t_k / T for all of them).
+  for (const Tool& tool : scene.tools) {
+    const SampledTrajectory path = sample(tool.trajectory);
+    if (path.samples.empty()) throw std::invalid_argument("reference: tool '" + tool.name + "' has an empty trajectory");
+    ReferenceTool rt;
+    rt.name = tool.name;
+    std::vector<double> times;
+    for (const ToolState& s : path.samples) {
+      rt.positions.push_back(s.position);
+      times.push_back(s.time);
     }
-  if (c.tied_triangles.empty())
-    throw std::invalid_argument("reference: scene '" + scene.name + "': no node of 'top' lies within the stylus radius of " +
-                                "its first contact point");
-  SurfaceGroup tie;
-  tie.name = "stylus_tie";
-  tie.triangles.resize(static_cast<Eigen::Index>(c.tied_triangles.size()), 3);
-  std::set<int> nodes;
-  for (std::size_t i = 0; i < c.tied_triangles.size(); ++i)
-    for (int k = 0; k < 3; ++k) {
-      tie.triangles(static_cast<Eigen::Index>(i), k) = top->triangles(c.tied_triangles[i], k);
-      nodes.insert(top->triangles(c.tied_triangles[i], k));
+    if (out.tools.empty()) {
+      out.times = times;
+    } else {
+      bool same = times.size() == out.times.size();
+      for (std::size_t k = 0; same && k < times.size(); ++k) same = std::abs(times[k] - out.times[k]) <= 1e-9;
+      if (!same)
+        throw std::invalid_argument("reference: scene '" + scene.name + "': tool '" + tool.name +
+                                    "' is sampled at other times than tool '" + out.tools.front().name +
+                                    "'; the reference needs one time line (same rate and duration)");
     }
-  c.tied_nodes = nodes.size();
-  p.mesh.surface_groups.push_back(std::move(tie));
+    out.tools.push_back(std::move(rt));
+  }
 
-  // u = p(λ T) − p(0): the tool displacement since contact, λ the load factor.
-  auto positions = std::make_shared<const std::vector<Eigen::Vector3d>>(out.positions);
-  auto times = std::make_shared<const std::vector<double>>(out.times);
-  const double T = out.times.back();
-  p.displacement_boundaries.push_back(
-      {"stylus_tie", DisplacementBoundary::Kind::prescribed,
-       [positions, times, T](const Eigen::Vector3d&, double load) -> Eigen::Vector3d {
-         return position_at(*positions, *times, load * T) - positions->front();
-       },
-       {true, true, true}});
+  const bool several = scene.tools.size() > 1;
+  for (std::size_t j = 0; j < scene.tools.size(); ++j) {
+    const Tool& tool = scene.tools[j];
+    ReferenceTool& rt = out.tools[j];
+    if (tool.kind == Tool::Kind::blade) {
+      if (several)
+        throw std::invalid_argument("reference: scene '" + scene.name + "' has " + std::to_string(scene.tools.size()) +
+                                    " tools and '" + tool.name + "' is a blade: several tools are coupled only as "
+                                    "styluses that grasp the surface (tied)");
+      reference::RigidToolShape shape;
+      shape.kind = reference::RigidToolShape::Kind::wedge;
+      shape.edge_direction = tool.blade.edge_direction;
+      shape.cutting_direction = tool.blade.cutting_direction;
+      shape.wedge_angle = tool.blade.wedge_angle;
+      shape.thickness = tool.blade.thickness;
+      shape.edge_length = tool.blade.edge_length;
+      p.tool = shape;
+      continue;
+    }
+    const std::string tie_name = several ? "stylus_tie_" + tool.name : "stylus_tie";
+    if (const auto tied = tie_stylus(scene, mesh, tool, rt.positions, out.times, tie_name, p)) {
+      rt.coupling = *tied;
+      continue;
+    }
+    if (several)
+      throw std::invalid_argument("reference: scene '" + scene.name + "': stylus '" + tool.name +
+                                  "' does not grasp the surface (it must start touching it and never move towards "
+                                  "it); several tools are coupled only as tied styluses");
+    // A sphere that presses: penalty contact.
+    reference::RigidToolShape shape;
+    shape.kind = reference::RigidToolShape::Kind::sphere;
+    shape.radius = tool.radius;
+    p.tool = shape;
+  }
   return out;
 }
 
@@ -340,7 +386,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   // downwards from the grasped top for a tear.
   const Eigen::Vector3d crack_direction =
       scene.tools.front().kind == Tool::Kind::blade ? scene.tools.front().blade.cutting_direction : Eigen::Vector3d(0, 0, -1);
-  const std::size_t n = rp.positions.size();
+  const std::size_t n = rp.times.size();
   std::vector<std::size_t> indices = settings.sample_indices;
   if (indices.empty())
     for (std::size_t k = 0; k < n; ++k) indices.push_back(k);
@@ -350,9 +396,11 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                   " (the trajectory's sample count); entry " + std::to_string(i) + " is " +
                                   std::to_string(indices[i]));
   const double T = rp.times.back();
-  auto load_of = [&](std::size_t k) { return LoadState{T > 0.0 ? rp.times[k] / T : 0.0, rp.positions[k], rp.times[k]}; };
-  const bool tied = rp.coupling.kind == ReferenceToolCoupling::Kind::tied;
-  const std::string tool_name = scene.tools.front().name;
+  // The penalty tool, if any, is the scene's only tool (reference_problem).
+  auto load_of = [&](std::size_t k) {
+    return LoadState{T > 0.0 ? rp.times[k] / T : 0.0, rp.tools.front().positions[k], rp.times[k]};
+  };
+  auto is_tied = [](const ReferenceTool& t) { return t.coupling.kind == ReferenceToolCoupling::Kind::tied; };
 
   reference::SolverSettings solver_settings;
   solver_settings.degree = settings.degree;
@@ -423,35 +471,52 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
       if (writer) std::fprintf(stderr, "reference %s: stopped: %s\n", scene.name.c_str(), e.what());
       break;
     }
-    Eigen::Vector3d tool_force = step.tool_force + Eigen::Vector3d::Zero(); // −0 → 0
-    Eigen::Vector3d support = step.support_reaction;
     const double cost = step.seconds;
     nlohmann::json reactions = nlohmann::json::object();
     for (const reference::BoundaryReaction& b : step.equilibrium.boundary_reactions)
       reactions[b.surface] = vec_json(b.force + Eigen::Vector3d::Zero());
-    if (tied) {
-      // The stylus tie is the last displacement boundary (reference_problem): the force of the
-      // body on the tied nodes is the force on the stylus; the supports carry the rest.
-      tool_force = step.equilibrium.boundary_reactions.back().force + Eigen::Vector3d::Zero(); // + 0: −0 → 0
-      support = step.support_reaction - tool_force;
+    // The force on each tool: a tied stylus's is the reaction of its tie (the force of the body on
+    // the tied nodes); a pressing tool's is the contact resultant. The supports carry the rest.
+    std::vector<Eigen::Vector3d> tool_forces, tool_positions, forces_on_body;
+    Eigen::Vector3d support = step.support_reaction;
+    bool touching = false;
+    nlohmann::json forces_json = nlohmann::json::object();
+    for (const ReferenceTool& tool : rp.tools) {
+      Eigen::Vector3d f = step.tool_force;
+      bool touches = step.equilibrium.contact_points + step.equilibrium.edge_contact_points > 0;
+      if (is_tied(tool)) {
+        f = step.equilibrium.boundary_reactions.at(static_cast<std::size_t>(tool.coupling.boundary)).force;
+        support -= f;
+        touches = f.norm() > 0.0;
+      }
+      f += Eigen::Vector3d::Zero(); // −0 → 0 in the CSV
+      touching = touching || touches;
+      tool_forces.push_back(f);
+      tool_positions.push_back(tool.positions[k]);
+      forces_on_body.push_back(-f);
+      forces_json[tool.name] = vec_json(f);
     }
-    ProfileRow row;
-    row.t = rp.times[k];
-    row.tool = tool_name;
-    row.position = rp.positions[k];
-    row.force = tool_force;
-    const bool touching = tied ? tool_force.norm() > 0.0
-                               : step.equilibrium.contact_points + step.equilibrium.edge_contact_points > 0;
-    row.mode = touching ? InteractionMode::deformation_1 : InteractionMode::no_contact;
     const reference::CohesiveSampleState interface{touching, step.equilibrium.cohesive.failed_area};
+    InteractionMode mode = touching ? InteractionMode::deformation_1 : InteractionMode::no_contact;
+    double crack_extent = 0.0;
     if (crack.active) {
-      row.mode = reference::reference_mode(previous_interface, interface);
-      row.crack_extent = solver.crack_extent(crack_direction);
+      mode = reference::reference_mode(previous_interface, interface);
+      crack_extent = solver.crack_extent(crack_direction);
     }
     previous_interface = interface;
-    energy.add_sample({rp.positions[k]}, {-tool_force}, solver.strain_energy(), step.equilibrium.cohesive);
-    row.cost_s = cost;
-    cp.profile.rows.push_back(row);
+    energy.add_sample(tool_positions, forces_on_body, solver.strain_energy(), step.equilibrium.cohesive);
+    for (std::size_t j = 0; j < rp.tools.size(); ++j) {
+      ProfileRow row;
+      row.t = rp.times[k];
+      row.tool = rp.tools[j].name;
+      row.position = tool_positions[j];
+      row.force = tool_forces[j];
+      row.mode = mode;
+      row.crack_extent = crack_extent;
+      row.cost_s = cost; // one solve for all the tools
+      cp.profile.rows.push_back(row);
+    }
+    const Eigen::Vector3d& tool_force = tool_forces.front();
     cp.samples.push_back({{"index", k},
                           {"t_s", rp.times[k]},
                           {"newton_iterations", step.newton_iterations},
@@ -460,6 +525,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                           {"residual_N", step.final_residual},
                           {"seconds", cost},
                           {"tool_force_N", vec_json(tool_force)},
+                          {"tool_forces_N", forces_json},
                           {"support_reaction_N", vec_json(support)},
                           {"boundary_reactions_N", reactions},
                           {"force_imbalance_N", vec_json(step.equilibrium.force_imbalance)},
@@ -488,8 +554,8 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
       std::fprintf(stderr,
                    "reference %s: sample %zu/%zu (#%zu, t = %.4f s) tool (%.3f, %.3f, %.3f) mm, %d Newton its, "
                    "%d cut-backs, |R| %.2e N, |F| %.4g N, elapsed %.1f s, ETA %.1f s\n",
-                   scene.name.c_str(), cp.solved, indices.size(), k, rp.times[k], rp.positions[k].x() * 1e3,
-                   rp.positions[k].y() * 1e3, rp.positions[k].z() * 1e3, step.newton_iterations, step.cutbacks,
+                   scene.name.c_str(), cp.solved, indices.size(), k, rp.times[k], tool_positions.front().x() * 1e3,
+                   tool_positions.front().y() * 1e3, tool_positions.front().z() * 1e3, step.newton_iterations, step.cutbacks,
                    step.final_residual, tool_force.norm(), elapsed, eta);
   }
   if (!stop.empty()) {
@@ -522,11 +588,22 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                 {"relative_tolerance", solver_settings.relative_tolerance},
                                 {"max_newton_iterations", solver_settings.max_newton_iterations},
                                 {"max_cutbacks", reference::LoadPathSettings{}.max_cutbacks},
-                                {"tool_coupling", tied ? "tied" : "penalty"}};
-  if (tied) {
-    solver_json["tied_nodes"] = rp.coupling.tied_nodes;
-    solver_json["tied_triangles"] = rp.coupling.tied_triangles.size();
-    solver_json["contact_point_m"] = vec_json(rp.coupling.contact_point);
+                                {"tool_coupling", is_tied(rp.tools.front()) ? "tied" : "penalty"}};
+  nlohmann::json tools_json = nlohmann::json::array();
+  for (const ReferenceTool& tool : rp.tools) {
+    nlohmann::json t = {{"name", tool.name}, {"coupling", is_tied(tool) ? "tied" : "penalty"}};
+    if (is_tied(tool)) {
+      t["tied_nodes"] = tool.coupling.tied_nodes;
+      t["tied_triangles"] = tool.coupling.tied_triangles.size();
+      t["contact_point_m"] = vec_json(tool.coupling.contact_point);
+    }
+    tools_json.push_back(t);
+  }
+  solver_json["tools"] = tools_json;
+  if (is_tied(rp.tools.front())) { // the first tool's, as before several tools were coupled
+    solver_json["tied_nodes"] = rp.tools.front().coupling.tied_nodes;
+    solver_json["tied_triangles"] = rp.tools.front().coupling.tied_triangles.size();
+    solver_json["contact_point_m"] = vec_json(rp.tools.front().coupling.contact_point);
   } else {
     solver_json["contact_penalty_Pa_per_m"] = solver.contact_penalty();
   }

@@ -51,15 +51,21 @@ struct ReferenceToolCoupling {
   Eigen::Vector3d contact_point = Eigen::Vector3d::Zero(); ///< tied: the body point first touched [m]
   std::vector<int> tied_triangles; ///< tied: rows of the `top` surface group tied to the stylus
   std::size_t tied_nodes = 0;      ///< tied: distinct mesh nodes of those triangles
+  int boundary = -1; ///< tied: index of its tie in FiniteStrainProblem::displacement_boundaries
+};
+
+/// One scene tool in the reference: how it is coupled, and its reference point at each sample.
+struct ReferenceTool {
+  std::string name;
+  ReferenceToolCoupling coupling;
+  std::vector<Eigen::Vector3d> positions; ///< [m], one per trajectory sample
 };
 
 /// The scene as the reference's boundary-value problem, and how its tool is coupled.
 struct ReferenceProblem {
   reference::FiniteStrainProblem problem;
-  ReferenceToolCoupling coupling;
-  /// The tool's reference point at each trajectory sample [m] and the sample times [s].
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<double> times;
+  std::vector<ReferenceTool> tools; ///< the scene's tools, in scene order
+  std::vector<double> times;        ///< the sample times [s], shared by every tool
 };
 
 /// Maps the scene to the reference problem: materials per region (layers first, then `body`,
@@ -67,13 +73,15 @@ struct ReferenceProblem {
 /// penalty contact, or — a sphere whose start touches the body and whose trajectory never moves
 /// towards it (clay_pull) — tied: the `top` triangles whose three nodes lie within the sphere
 /// radius of the first contact point (if none, those with at least one such node) get the
-/// prescribed displacement u = p(t) − p(0), the tool displacement since contact. Throws
-/// std::invalid_argument for a scene with more than one tool, or a tied tool without a `top`
-/// surface. The load factor of sample k is t_k / T (T the trajectory duration).
+/// prescribed displacement u = p(t) − p(0), the tool displacement since contact. Several tools
+/// (clay_tear: two hands pulling) are coupled only as tied styluses, each with its own tie group
+/// `stylus_tie_<name>`. Throws std::invalid_argument for several tools of which one is not a tied
+/// stylus, tools on different time lines, or a tied tool without a `top` surface. The load factor
+/// of sample k is t_k / T (T the trajectory duration).
 ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh);
 
-/// Runs the reference on the scene (see file comment) and returns the profile: one row per solved
-/// sample (t, tool position, force of the body on the tool, mode no-contact when the tool force is
+/// Runs the reference on the scene (see file comment) and returns the profile: one row per tool per
+/// solved sample (t, tool position, force of the body on the tool, mode no-contact when the tool force is
 /// zero (tied) / no contact point (penalty) else deformation-1, crack_extent 0, cost_s = solve
 /// seconds). The tool force of a tied tool is the reaction on the tied nodes. If the load path
 /// stops (cut-backs exhausted), returns the profile up to the last converged sample and records
