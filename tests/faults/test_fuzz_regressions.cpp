@@ -2,8 +2,13 @@
 // through the same harness in the normal suite (and so under ASan + UBSan in the asan stage),
 // and, for each finding, what the fixed parser now says about it.
 
+#include "experiments/calibration/calibration.hpp"
+#include "experiments/run/model_catalogue.hpp"
+#include "experiments/run/reference_checkpoint.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/study_spec.hpp"
 #include "experiments/trajectory/trajectory.hpp"
+#include "fuzz/catalogue_model_names.hpp"
 #include "fuzz/fuzz_targets.hpp"
 #include "realtime/haptics/session_file.hpp"
 
@@ -11,6 +16,8 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -138,4 +145,129 @@ TEST(FuzzRegressions, NonAsciiWhereTomlExpectsWhitespaceIsASyntaxError) {
   const fs::path scene_file = scratch("clay_pull.toml");
   std::ofstream(scene_file) << text;
   EXPECT_EQ(read_scene(scene_file).description, "\xC2\xA7 5.1");
+}
+
+TEST(FuzzRegressions, CorruptReferenceCheckpointsAreErrorsNotJsonExceptionsOrHugeAllocations) {
+  // Findings (fuzz_reference_checkpoint): (1) sample records that are not JSON escaped from
+  // read_reference_checkpoint as nlohmann::json::parse_error (saved input: a control character
+  // in a key), and records of the wrong shape would have escaped run_reference's resume as
+  // nlohmann type errors, or converted a JSON number outside int with undefined behaviour;
+  // (2) a count was trusted up to 2^32 items (2^34 for the state): a 42 kB input made the reader
+  // allocate 1.2 GB (libFuzzer peak RSS, 6 inputs/s), and the saved 164-byte input asks for
+  // 2^32 - 1 indices, 32 GiB. Now a count must fit in the bytes left in the file, and the records
+  // must be what run_reference resumes from; both are std::runtime_errors naming the file.
+  const fs::path dir = regressions / "reference_checkpoint";
+  const auto message = [](const fs::path& file) { return error_of([&] { read_reference_checkpoint(file); }); };
+  EXPECT_NE(message(dir / "json_control_character.bin").find("corrupt sample records"), std::string::npos);
+  EXPECT_NE(message(dir / "huge_index_count.bin").find("corrupt count"), std::string::npos);
+
+  // A checkpoint as run_reference writes it reads back whole (the independent check: every field
+  // equal to what was written).
+  ReferenceCheckpoint c;
+  c.scene_sha256 = std::string(64, 'a');
+  c.degree = 2;
+  c.refinements = 1;
+  c.processes = 3;
+  c.indices = {0, 4, 8};
+  c.solved = 2;
+  c.last.load_factor = 0.5;
+  c.last.tool_position = {1e-3, 2e-3, 3e-3};
+  c.state = {1.0, -2.0, 3.5};
+  for (int k = 0; k < 2; ++k) {
+    ProfileRow row;
+    row.t = 0.1 * k;
+    row.tool = "stylus";
+    row.force = {0.0, 0.0, 1.5 * k};
+    row.mode = InteractionMode::deformation_1;
+    c.profile.rows.push_back(row);
+    c.samples.push_back({{"index", 4 * k}, {"newton_iterations", 3}, {"contact_points", k}});
+  }
+  c.solve_seconds = 1.25;
+  const fs::path file = scratch("checkpoint.bin");
+  write_reference_checkpoint(c, file);
+  const ReferenceCheckpoint back = read_reference_checkpoint(file);
+  EXPECT_EQ(back.scene_sha256, c.scene_sha256);
+  EXPECT_EQ(back.indices, c.indices);
+  EXPECT_EQ(back.solved, 2u);
+  EXPECT_EQ(back.state, c.state);
+  EXPECT_EQ(back.last.tool_position, c.last.tool_position);
+  ASSERT_EQ(back.profile.rows.size(), 2u);
+  EXPECT_EQ(back.profile.rows[1].force, c.profile.rows[1].force);
+  EXPECT_EQ(back.samples, c.samples);
+  EXPECT_EQ(back.solve_seconds, 1.25);
+
+  // Records run_reference could not resume from.
+  for (const nlohmann::json& bad : {nlohmann::json{{"newton_iterations", 1e300}, {"contact_points", 0}},
+                                    nlohmann::json{{"newton_iterations", "3"}, {"contact_points", 0}},
+                                    nlohmann::json{{"newton_iterations", 3}},
+                                    nlohmann::json{{"newton_iterations", 3}, {"contact_points", 0}, {"energy", 1}}}) {
+    ReferenceCheckpoint corrupt = c;
+    corrupt.samples[1] = bad;
+    write_reference_checkpoint(corrupt, file);
+    EXPECT_NE(message(file).find("corrupt sample records"), std::string::npos) << bad.dump();
+  }
+  ReferenceCheckpoint short_records = c;
+  short_records.samples.erase(1); // two solved samples, one record
+  write_reference_checkpoint(short_records, file);
+  EXPECT_NE(message(file).find("corrupt sample records"), std::string::npos);
+}
+
+TEST(FuzzHarnesses, TheFuzzBuildsModelNamesAreTheCatalogues) {
+  // The fuzz build checks a study's models against fuzz/catalogue_model_names.hpp instead of the
+  // catalogue (which links every model builder): the two lists must be the same.
+  std::vector<std::string_view> names;
+  for (const ModelDescription& d : model_catalogue()) names.push_back(d.name);
+  EXPECT_TRUE(std::equal(names.begin(), names.end(), fuzz::catalogue_model_names.begin(),
+                         fuzz::catalogue_model_names.end()));
+}
+
+TEST(FuzzHarnesses, ParameterFilesWrittenByCalibrateReadBackThroughTheHarness) {
+  // Every parameter file `kerf calibrate` can write for a repository scene (parameter_file_text
+  // with the scene's own values) passes fuzz_parameter_file with that scene picked, and the
+  // scene read with it has the values written, to the 9 significant digits they are written with.
+  const fuzz::FuzzHarness harness = fuzz::find_harness("parameter_file");
+  ASSERT_NE(harness, nullptr);
+  std::vector<fs::path> scenes;
+  for (const auto& e : fs::directory_iterator(KERF_SCENES_DIR))
+    if (e.path().extension() == ".toml") scenes.push_back(e.path());
+  std::sort(scenes.begin(), scenes.end()); // the harness's order: the first byte is the index
+  int written = 0;
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    const Scene scene = read_scene(scenes[k]);
+    for (const std::string model : {"fracture", "springs", "voxel"}) {
+      CalibratedParameters p;
+      try {
+        p = scene_parameters(model, scene);
+      } catch (const std::exception&) {
+        continue; // the scene has no section for the model, or the model no free parameter
+      }
+      for (double& v : p.values) v *= 1.5; // values the scene does not already have
+      const std::string text = parameter_file_text(p, "calibrated for the test\n\nby hand");
+      std::vector<std::byte> data{static_cast<std::byte>(k)};
+      for (char c : text) data.push_back(static_cast<std::byte>(c));
+      EXPECT_NO_THROW(harness(data)) << scenes[k] << " " << model;
+      const fs::path file = scratch("calibrated.toml");
+      std::ofstream(file) << text;
+      const CalibratedParameters back = scene_parameters(model, read_scene(scenes[k], {file}));
+      ASSERT_EQ(back.values.size(), p.values.size());
+      for (std::size_t i = 0; i < p.values.size(); ++i)
+        EXPECT_NEAR(back.values[i], p.values[i], 1e-8 * std::abs(p.values[i])) << scenes[k] << " " << model << " " << i;
+      ++written;
+    }
+  }
+  EXPECT_GE(written, 5); // fracture on the cutting scenes, voxel on the sponges, springs on the clay scenes
+}
+
+TEST(FuzzHarnesses, TheRepositoryStudiesPassTheStudyHarness) {
+  // The seeds of fuzz_study: every study file of the repository is accepted, as it is.
+  const fuzz::FuzzHarness harness = fuzz::find_harness("study");
+  ASSERT_NE(harness, nullptr);
+  int studies = 0;
+  for (const auto& e : fs::directory_iterator(KERF_STUDIES_DIR)) {
+    if (e.path().extension() != ".toml") continue;
+    EXPECT_NO_THROW(harness(bytes_of(e.path()))) << e.path();
+    EXPECT_NO_THROW(read_study(e.path())) << e.path();
+    ++studies;
+  }
+  EXPECT_GE(studies, 1);
 }
