@@ -27,7 +27,8 @@ void fuzz_study_table(std::span<const std::byte> data) {
     if (c.scene != scene || c.model.rfind("reference", 0) == 0)
       throw FuzzFinding("a recommended row of another scene, or a reference row");
     // model_recommendation.hpp: "a measured error <= max_error and a p99 cost <= 1 / rate".
-    if (!c.rms_error || !c.p99_cost || !(*c.rms_error <= max_error) || !(*c.p99_cost <= 1.0 / rate))
+    if (!c.rms_error || !c.p99_cost || !(*c.rms_error >= 0.0 && *c.rms_error <= max_error) ||
+        !(*c.p99_cost >= 0.0 && *c.p99_cost <= 1.0 / rate))
       throw FuzzFinding("a recommended row outside the error or cost budget");
   }
 }

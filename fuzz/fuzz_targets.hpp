@@ -72,7 +72,8 @@ void fuzz_parameter_file(std::span<const std::byte> data);
 
 /// Study tables read back by `kerf recommend` (experiments/study/model_recommendation.hpp). Only
 /// std::runtime_error may be thrown; for every scene of the rows read, a recommended row must be
-/// of that scene, not a reference row, and within both budgets (error <= 10 %, p99 cost <= 1 ms).
+/// of that scene, not a reference row, and within both budgets (0 <= error <= 10 %, 0 <= p99 cost
+/// <= 1 ms).
 void fuzz_study_table(std::span<const std::byte> data);
 
 /// Reference checkpoints (experiments/run/reference_checkpoint.hpp, read by `kerf reference

@@ -6,10 +6,12 @@
 #include "experiments/run/model_catalogue.hpp"
 #include "experiments/run/reference_checkpoint.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/model_recommendation.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "experiments/trajectory/trajectory.hpp"
 #include "fuzz/catalogue_model_names.hpp"
 #include "fuzz/fuzz_targets.hpp"
+#include "realtime/haptics/replay_device.hpp"
 #include "realtime/haptics/session_file.hpp"
 
 #include <gtest/gtest.h>
@@ -210,6 +212,87 @@ TEST(FuzzRegressions, CorruptReferenceCheckpointsAreErrorsNotJsonExceptionsOrHug
   short_records.samples.erase(1); // two solved samples, one record
   write_reference_checkpoint(short_records, file);
   EXPECT_NE(message(file).find("corrupt sample records"), std::string::npos);
+}
+
+TEST(FuzzRegressions, StudyWithAnUnlookableSceneNameOrSamplesPastIntIsAStudyError) {
+  // Found by reading study_spec.cpp, confirmed through fuzz_study (the 4-minute run did not reach
+  // them): (1) a scene name the file system cannot look up (300 characters: ENAMETOOLONG) escaped
+  // as std::filesystem::filesystem_error, which names no line; (2) samples = 4294967297 was
+  // accepted and converted to int as 1 (below the documented minimum of 2). Both are now
+  // StudyErrors naming file:line:column and the key.
+  const auto message = [](const fs::path& file) {
+    try {
+      read_study(file);
+    } catch (const StudyError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string name = message(regressions / "study" / "scene_name_too_long.toml");
+  EXPECT_NE(name.find("scene_name_too_long.toml:3:"), std::string::npos) << name;
+  EXPECT_NE(name.find("study.scenes: no scene"), std::string::npos) << name;
+  const std::string samples = message(regressions / "study" / "samples_past_int.toml");
+  EXPECT_NE(samples.find("samples_past_int.toml:6:"), std::string::npos) << samples;
+  EXPECT_NE(samples.find("reference.samples: expected an integer in 2..2147483647"), std::string::npos) << samples;
+  // The largest int still reads (the bound is the type's, not a smaller policy).
+  const fs::path ok = scratch("largest_samples.toml");
+  std::ofstream(ok) << "[study]\nname = \"x\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n"
+                    << "[reference]\nsamples = 2147483647\n";
+  EXPECT_EQ(read_study(ok).reference.samples, 2147483647);
+}
+
+TEST(FuzzRegressions, StudyTableWithANonFiniteOrNegativeMeasurementIsAnError) {
+  // Found by reading model_recommendation.cpp, confirmed through fuzz_study_table: "nan" in the
+  // error column (or "-inf" as a cost) read as a number, passed every budget comparison of
+  // recommend_model and was recommended ("nan %" within 10 %). A measured error or cost is now
+  // empty or a finite number >= 0; anything else is an error naming file:line.
+  for (const char* name : {"nan_error.csv", "negative_infinite_cost.csv"}) {
+    const std::string message = error_of([&] { read_study_rows(regressions / "study_table" / name); });
+    EXPECT_NE(message.find(std::string(name) + ":2: "), std::string::npos) << message;
+    EXPECT_NE(message.find("is not a finite number >= 0"), std::string::npos) << message;
+  }
+  // Zero and an empty field still read (a perfect model; a row that was not scored).
+  const fs::path ok = scratch("study.csv");
+  std::ofstream(ok) << "scene,model,RMS force error [%],p99 cost [\xC2\xB5s]\npotato,a,0,0\npotato,b,,\n";
+  const auto rows = read_study_rows(ok);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].rms_error, 0.0);
+  EXPECT_FALSE(rows[1].rms_error.has_value());
+  EXPECT_EQ(recommend_model(rows, "potato", 0.1, 1000.0).choice->model, "a");
+}
+
+TEST(FuzzRegressions, ReplayNeverGivesANonFinitePosition) {
+  // Finding (fuzz_replay, the 4-minute run): a session file whose tick 1 has the time "0.<NUL
+  // bytes>35099..." read as t = 0 (strtod stops at the NUL, and the check looked for the NUL,
+  // not the field's end), so ticks 0 and 1 had the same time; the replay divided by that zero
+  // time step and gave a NaN position, which no link check stands between it and the model.
+  // Now a number must fill its whole field (session files and replay CSVs), and a session's
+  // times must increase strictly to be replayed.
+  const std::string session = error_of([] { read_session(regressions / "replay" / "session_time_with_nul.csv"); });
+  EXPECT_NE(session.find("session_time_with_nul.csv:5: column t: expected a finite number"), std::string::npos) << session;
+  const std::string header = "# kerf haptic session v1\n# rate_hz=1000 model=m scene=s tools=a\n" +
+                             std::string(session_csv_header) + "\n";
+  const std::string row_tail = ",a,0,0,0,0,0,0,1,0,0,0,0,0,0,0,0,0,0,no-contact,0,0,0,0,0,0\n";
+  const fs::path same_time = scratch("same_time.csv");
+  std::ofstream(same_time) << header << "0,0.5" << row_tail << "1,0.5" << row_tail;
+  EXPECT_EQ(read_session(same_time).ticks.size(), 2u); // a valid session file ...
+  EXPECT_NE(error_of([&] { ReplayDevice device(same_time, 0, 8.5); }).find("tick 1: time must increase strictly"),
+            std::string::npos); // ... but not a replay
+  // Found by reading the interpolation, confirmed through fuzz_replay: finite samples whose
+  // difference overflows (1e308 m, then -1e308 m) gave NaN at the first poll (0 x -Inf). Now
+  // (1 - s) p0 + s p1, finite; and a normal replay still interpolates linearly (independent
+  // value: halfway between (0,0,0) and (2,4,6) mm at t = 0.5 s of 1 s is (1,2,3) mm).
+  ReplayDevice extreme(regressions / "replay" / "position_difference_overflows.csv", 0, 8.5);
+  for (const double now : {0.0, 0.5, 1.0, 2.0}) {
+    extreme.poll(now);
+    EXPECT_TRUE(extreme.state().position.allFinite()) << now;
+  }
+  const fs::path line = scratch("line.csv");
+  std::ofstream(line) << "t,px,py,pz\n0,0,0,0\n1,0.002,0.004,0.006\n";
+  ReplayDevice replay(line, 0, 8.5);
+  replay.poll(10.0);
+  replay.poll(10.5);
+  EXPECT_NEAR((replay.state().position - Eigen::Vector3d(0.001, 0.002, 0.003)).norm(), 0.0, 1e-15);
 }
 
 TEST(FuzzHarnesses, TheFuzzBuildsModelNamesAreTheCatalogues) {
