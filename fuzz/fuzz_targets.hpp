@@ -54,8 +54,43 @@ void fuzz_session_csv(std::span<const std::byte> data);
 /// std::runtime_error may be thrown; rows must be finite with a tool name.
 void fuzz_profile_csv(std::span<const std::byte> data);
 
+/// Study files (experiments/study/study_spec.hpp, `kerf study FILE`): the input is written as
+/// study.toml in the scratch folder, beside a parameter file calibrated.toml ([models.fracture])
+/// that a [calibration] entry may name; scene names resolve beside it, then in experiments/scenes.
+/// Only StudyError may be thrown; an accepted study must satisfy study_spec.hpp's ranges (a name,
+/// at least one existing scene and one catalogue model, degree 1 or 2, levels 0..4, samples >= 2,
+/// calibrations only for its scenes).
+void fuzz_study(std::span<const std::byte> data);
+
+/// Parameter files (`kerf calibrate -o`, included by scenes; experiments/scene/scene_reader.hpp):
+/// the first byte picks one of the repository's scenes (experiments/scenes/*.toml, sorted), the
+/// rest is the parameter file given to read_scene after the scene's own includes. The same file
+/// goes through calibrated_models (the study's reader of parameter files). Only SceneError (scene)
+/// and StudyError (study) may be thrown; a file the scene accepts calibrates only fracture, voxel
+/// or springs, and the scene read with it has that model's section.
+void fuzz_parameter_file(std::span<const std::byte> data);
+
+/// Study tables read back by `kerf recommend` (experiments/study/model_recommendation.hpp). Only
+/// std::runtime_error may be thrown; for every scene of the rows read, a recommended row must be
+/// of that scene, not a reference row, and within both budgets (0 <= error <= 10 %, 0 <= p99 cost
+/// <= 1 ms).
+void fuzz_study_table(std::span<const std::byte> data);
+
+/// Reference checkpoints (experiments/run/reference_checkpoint.hpp, read by `kerf reference
+/// --resume`). Only std::runtime_error may be thrown; an accepted checkpoint has no more samples
+/// solved than requested, valid modes, and sample records that run_reference can resume from
+/// (what it reads of them is read here too: a JSON type error escaping is a finding).
+void fuzz_reference_checkpoint(std::span<const std::byte> data);
+
+/// Replay files of the `replay:FILE` device (realtime/haptics/replay_device.hpp): a trajectory
+/// CSV or a session file, played as tool 0. Only std::runtime_error may be thrown; an accepted
+/// replay has a positive duration and gives a finite position at every poll, before, during and
+/// after its time span.
+void fuzz_replay(std::span<const std::byte> data);
+
 /// A harness by name ("device_protocol", "quantity", "scene", "trajectory_csv", "session_csv",
-/// "profile_csv"), or nullptr.
+/// "profile_csv", "study", "parameter_file", "study_table", "reference_checkpoint", "replay"), or
+/// nullptr.
 using FuzzHarness = void (*)(std::span<const std::byte>);
 FuzzHarness find_harness(std::string_view name);
 

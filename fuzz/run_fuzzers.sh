@@ -16,7 +16,7 @@ build="${KERF_FUZZ_BUILD_DIR:-$here/build-fuzz}"
 seconds="${1:-30}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(device_protocol quantity scene trajectory_csv session_csv profile_csv)
+[ ${#targets[@]} -eq 0 ] && targets=(device_protocol quantity scene trajectory_csv session_csv profile_csv study parameter_file study_table reference_checkpoint replay)
 
 cmake -S "$here" -B "$build" -DKERF_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
 cmake --build "$build" -j2

@@ -7,13 +7,24 @@
 //   seeds/session_csv/     the same motion as a session file, written by SessionRecorder
 //   seeds/profile_csv/     the same motion as a force profile, written by write_profile_csv
 //   seeds/device_protocol/ the same motion as device-state datagrams, then a force command
+//   seeds/reference_checkpoint/ the same motion as a reference checkpoint (kerf's own writer)
+//   seeds/replay/          the trajectory CSVs and session files above (both are replay files)
+//   seeds/study/           the study files given with --study, copied, and each again with a
+//                          [calibration] entry for its first scene naming calibrated.toml (the
+//                          parameter file fuzz_study writes beside the input)
+//   seeds/parameter_file/  the [models.*] tables of each scene in experiments/scenes, as a
+//                          parameter file, after the byte that makes fuzz_parameter_file pick
+//                          that scene (its index in the sorted folder)
+//   seeds/study_table/     each Markdown table of the --results pages (docs/results.md, written
+//                          by `kerf study`) as the study.csv it was written beside ("–" empty)
 // The CSV seeds carry the scenes' sampled motion (at most 64 rows); forces are zero and modes
 // cycle through the five spellings, so every column form is present (the seeds give the fuzzer
 // the formats' structure, not physics).
 //
-//   write_seed_corpus OUT_DIR SCENE.toml...
+//   write_seed_corpus OUT_DIR [--study STUDY.toml]... [--results PAGE.md]... SCENE.toml...
 
 #include "experiments/profile/force_profile.hpp"
+#include "experiments/run/reference_checkpoint.hpp"
 #include "experiments/scene/quantity.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "realtime/haptics/device_protocol.hpp"
@@ -21,11 +32,14 @@
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <set>
+#include <sstream>
+#include <string>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -84,9 +98,10 @@ void write_motion_seeds(const Scene& scene, const fs::path& out) {
   const std::size_t samples = motion.front().samples.size();
   const std::size_t stride = std::max<std::size_t>(1, samples / 64);
 
-  // Recorded trajectory CSV, one per tool: t,px,py,pz.
+  // Recorded trajectory CSV, one per tool: t,px,py,pz (also a replay file).
   for (std::size_t i = 0; i < motion.size(); ++i) {
-    std::ofstream csv(out / "trajectory_csv" / (name + "_" + scene.tools[i].name + ".csv"));
+    const fs::path file = out / "trajectory_csv" / (name + "_" + scene.tools[i].name + ".csv");
+    std::ofstream csv(file);
     csv << "t,px,py,pz\n";
     char row[128];
     for (std::size_t k = 0; k < motion[i].samples.size(); k += stride) {
@@ -95,6 +110,8 @@ void write_motion_seeds(const Scene& scene, const fs::path& out) {
                     s.position.z());
       csv << row;
     }
+    csv.close();
+    fs::copy_file(file, out / "replay" / file.filename(), fs::copy_options::overwrite_existing);
   }
 
   // Session file and force profile: every tool at each kept sample.
@@ -125,7 +142,40 @@ void write_motion_seeds(const Scene& scene, const fs::path& out) {
     }
     recorder.close();
   }
+  fs::copy_file(out / "session_csv" / (name + ".csv"), out / "replay" / (name + "_session.csv"),
+                fs::copy_options::overwrite_existing);
   write_profile_csv(profile, out / "profile_csv" / (name + ".csv"));
+
+  // Reference checkpoint: the first tool's rows as solved samples, with the manifest record of
+  // each (reference_run.cpp's fields; the energy record as EnergyBookkeeping::to_json writes it)
+  // and its positions as the solver state.
+  ReferenceCheckpoint checkpoint;
+  checkpoint.scene_sha256 = std::string(64, '0');
+  checkpoint.degree = 1;
+  checkpoint.processes = 1;
+  for (const ProfileRow& row : profile.rows) {
+    if (row.tool != scene.tools.front().name) continue;
+    const std::size_t k = checkpoint.indices.size();
+    checkpoint.indices.push_back(k * stride);
+    checkpoint.profile.rows.push_back(row);
+    for (int d = 0; d < 3; ++d) checkpoint.state.push_back(row.position[d]);
+    const nlohmann::json p = {row.position.x(), row.position.y(), row.position.z()};
+    const nlohmann::json f = {row.force.x(), row.force.y(), row.force.z()};
+    checkpoint.samples.push_back({{"index", k * stride}, {"t_s", row.t}, {"newton_iterations", 3}, {"cutbacks", 0},
+                                  {"increments", 1}, {"residual_N", 1e-9}, {"seconds", 0.01}, {"tool_force_N", f},
+                                  {"support_reaction_N", f}, {"contact_points", static_cast<int>(k % 2)},
+                                  {"energy", {{"external_work_J", 0.0}, {"stored_elastic_energy_J", 0.0},
+                                              {"interface_energy_J", 0.0}, {"cohesive_dissipation_J", 0.0},
+                                              {"viscous_dissipation_J", 0.0}, {"friction_dissipation_J", 0.0},
+                                              {"failed_area_m2", 0.0}, {"balance_error", 0.0},
+                                              {"last_positions_m", nlohmann::json::array({p})},
+                                              {"last_forces_on_body_N", nlohmann::json::array({f})}}}});
+    checkpoint.solve_seconds += 0.01;
+  }
+  checkpoint.solved = checkpoint.indices.size();
+  if (!checkpoint.profile.rows.empty()) checkpoint.last.tool_position = checkpoint.profile.rows.back().position;
+  checkpoint.last.load_factor = 1.0;
+  write_reference_checkpoint(checkpoint, out / "reference_checkpoint" / (name + ".bin"));
 
   // Device protocol: length-prefixed datagrams (fuzz_targets.hpp), the first tool's motion.
   std::vector<std::byte> stream;
@@ -152,20 +202,136 @@ void write_motion_seeds(const Scene& scene, const fs::path& out) {
   write_bytes(out / "device_protocol" / (name + ".bin"), stream);
 }
 
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::runtime_error(file.string() + ": cannot read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void write_text(const fs::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out) throw std::runtime_error(file.string() + ": cannot write the seed");
+}
+
+/// The study file, and the same with a [calibration] entry naming calibrated.toml for its first
+/// scene (when it has none and its scenes parse).
+void write_study_seeds(const fs::path& study, const fs::path& out) {
+  const std::string text = read_text(study);
+  write_text(out / study.filename(), text);
+  toml::table doc;
+  try {
+    doc = toml::parse(text, study.string());
+  } catch (const toml::parse_error&) {
+    return;
+  }
+  const auto first_scene = doc["study"]["scenes"][0].value<std::string>();
+  if (!first_scene || doc.contains("calibration")) return;
+  write_text(out / (study.stem().string() + "_calibrated.toml"),
+             text + "\n[calibration]\n" + *first_scene + " = [\"calibrated.toml\"]\n");
+}
+
+/// One seed per scene of experiments/scenes with [models.*] tables: the byte that picks it in
+/// fuzz_parameter_file (its index in the sorted folder), then those tables as a parameter file.
+int write_parameter_file_seeds(const fs::path& out) {
+  std::vector<fs::path> scenes;
+  for (const auto& e : fs::directory_iterator(KERF_SCENES_DIR))
+    if (e.path().extension() == ".toml") scenes.push_back(e.path());
+  std::sort(scenes.begin(), scenes.end());
+  int written = 0;
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    const toml::table doc = toml::parse_file(scenes[k].string());
+    const toml::table* models = doc["models"].as_table();
+    if (models == nullptr) continue;
+    std::ostringstream text;
+    text << "# the [models.*] tables of " << scenes[k].filename().string() << "\n"
+         << toml::table{{"models", *models}} << "\n";
+    std::vector<std::byte> bytes{static_cast<std::byte>(k)};
+    for (char c : text.str()) bytes.push_back(static_cast<std::byte>(c));
+    write_bytes(out / (scenes[k].stem().string() + ".toml"), bytes);
+    ++written;
+  }
+  return written;
+}
+
+/// Splits a Markdown table row "| a | b |" into its cells, trimmed.
+std::vector<std::string> markdown_cells(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  for (std::size_t k = 1; k < line.size(); ++k) {
+    if (line[k] != '|') {
+      cell += line[k];
+      continue;
+    }
+    const auto first = cell.find_first_not_of(' ');
+    const auto last = cell.find_last_not_of(' ');
+    cells.push_back(first == std::string::npos ? "" : cell.substr(first, last - first + 1));
+    cell.clear();
+  }
+  return cells;
+}
+
+/// Each Markdown table of `page` as a CSV (RFC 4180; "–", not measured, as an empty field).
+int write_study_table_seeds(const fs::path& page, const fs::path& out) {
+  std::istringstream lines(read_text(page));
+  std::string csv;
+  int tables = 0;
+  const auto flush = [&] {
+    if (csv.empty()) return;
+    write_text(out / (page.stem().string() + "_" + std::to_string(++tables) + ".csv"), csv);
+    csv.clear();
+  };
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("|", 0) != 0) {
+      flush();
+      continue;
+    }
+    if (line.rfind("|---", 0) == 0) continue; // the alignment row
+    std::string row;
+    for (const std::string& cell : markdown_cells(line)) {
+      std::string field = cell == "–" ? "" : cell;
+      if (field.find_first_of(",\"") != std::string::npos) {
+        std::string quoted = "\"";
+        for (char c : field) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+        field = quoted + "\"";
+      }
+      row += (row.empty() ? "" : ",") + field;
+    }
+    csv += row + "\n";
+  }
+  flush();
+  return tables;
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::cerr << "usage: write_seed_corpus OUT_DIR SCENE.toml...\n";
+    std::cerr << "usage: write_seed_corpus OUT_DIR [--study STUDY.toml]... [--results PAGE.md]... SCENE.toml...\n";
     return 64;
   }
   const fs::path out = argv[1];
-  for (const char* target : {"scene", "quantity", "trajectory_csv", "session_csv", "profile_csv", "device_protocol"})
+  for (const char* target : {"scene", "quantity", "trajectory_csv", "session_csv", "profile_csv", "device_protocol",
+                             "study", "parameter_file", "study_table", "reference_checkpoint", "replay"})
     fs::create_directories(out / target);
   std::set<std::string> quantities;
-  int scenes = 0, readable = 0;
+  int scenes = 0, readable = 0, studies = 0, tables = 0, parameter_files = 0;
   try {
+    parameter_files = write_parameter_file_seeds(out / "parameter_file");
     for (int a = 2; a < argc; ++a) {
+      const std::string option = argv[a];
+      if ((option == "--study" || option == "--results") && a + 1 < argc) {
+        const fs::path file = argv[++a];
+        if (option == "--study") {
+          write_study_seeds(file, out / "study");
+          ++studies;
+        } else {
+          tables += write_study_table_seeds(file, out / "study_table");
+        }
+        continue;
+      }
       const fs::path file = argv[a];
       fs::copy_file(file, out / "scene" / (file.parent_path().filename().string() + "_" + file.filename().string()),
                     fs::copy_options::overwrite_existing);
@@ -185,6 +351,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::cout << "write_seed_corpus: " << scenes << " scene files (" << readable << " readable), " << quantities.size()
-            << " quantities -> " << out.string() << '\n';
+            << " quantities, " << studies << " studies, " << parameter_files << " parameter files, " << tables
+            << " study tables -> " << out.string() << '\n';
   return 0;
 }

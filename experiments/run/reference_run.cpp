@@ -1,5 +1,6 @@
 #include "experiments/run/reference_run.hpp"
 
+#include "experiments/run/reference_checkpoint.hpp"
 #include "experiments/trajectory/trajectory.hpp"
 #include "meshes/atomic_file.hpp"
 #include "meshes/surface_mesh.hpp"
@@ -195,152 +196,6 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh) {
 
 namespace {
 
-// ---------------------------------------------------------------------------------- checkpoint
-// Binary, native byte order (a checkpoint is resumed on the machine that wrote it):
-// "KERFREF2", scene sha256, degree, refinements, process count, sample indices, targets solved,
-// the last converged load, the solver state (global DOF order, which depends on the process
-// count), the profile rows, the per-sample manifest records.
-
-constexpr char checkpoint_magic[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '2'};
-
-struct Checkpoint {
-  std::string scene_sha256;
-  int degree = 0, refinements = 0;
-  int processes = 1; ///< MPI processes the mesh was distributed over
-  std::vector<std::size_t> indices;
-  std::size_t solved = 0;
-  LoadState last;
-  std::vector<double> state;
-  ForceProfile profile;
-  nlohmann::json samples = nlohmann::json::array();
-  double solve_seconds = 0.0;
-};
-
-class Writer {
-public:
-  explicit Writer(std::ofstream& out) : m_out(out) {}
-  void u64(std::uint64_t v) { m_out.write(reinterpret_cast<const char*>(&v), sizeof v); }
-  void i32(std::int32_t v) { m_out.write(reinterpret_cast<const char*>(&v), sizeof v); }
-  void f64(double v) { m_out.write(reinterpret_cast<const char*>(&v), sizeof v); }
-  void str(const std::string& s) {
-    u64(s.size());
-    m_out.write(s.data(), static_cast<std::streamsize>(s.size()));
-  }
-  void vec(const Eigen::Vector3d& v) {
-    for (int k = 0; k < 3; ++k) f64(v[k]);
-  }
-
-private:
-  std::ofstream& m_out;
-};
-
-class Reader {
-public:
-  Reader(std::ifstream& in, std::filesystem::path file) : m_in(in), m_file(std::move(file)) {}
-  template <class T> T pod() {
-    T v{};
-    m_in.read(reinterpret_cast<char*>(&v), sizeof v);
-    if (!m_in) throw std::runtime_error("reference checkpoint " + m_file.string() + ": truncated");
-    return v;
-  }
-  std::uint64_t u64() { return pod<std::uint64_t>(); }
-  std::uint64_t count(std::uint64_t limit) {
-    const std::uint64_t n = u64();
-    if (n > limit) throw std::runtime_error("reference checkpoint " + m_file.string() + ": corrupt count");
-    return n;
-  }
-  double f64() { return pod<double>(); }
-  std::string str() {
-    std::string s(count(std::uint64_t{1} << 32), '\0');
-    m_in.read(s.data(), static_cast<std::streamsize>(s.size()));
-    if (!m_in) throw std::runtime_error("reference checkpoint " + m_file.string() + ": truncated");
-    return s;
-  }
-  Eigen::Vector3d vec() {
-    Eigen::Vector3d v;
-    for (int k = 0; k < 3; ++k) v[k] = f64();
-    return v;
-  }
-
-private:
-  std::ifstream& m_in;
-  std::filesystem::path m_file;
-};
-
-void write_checkpoint(const Checkpoint& c, const std::filesystem::path& file) {
-  write_atomically(file, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw std::runtime_error("reference: cannot write checkpoint " + tmp.string());
-    Writer w(out);
-    out.write(checkpoint_magic, sizeof checkpoint_magic);
-    w.str(c.scene_sha256);
-    w.i32(c.degree);
-    w.i32(c.refinements);
-    w.i32(c.processes);
-    w.u64(c.indices.size());
-    for (std::size_t i : c.indices) w.u64(i);
-    w.u64(c.solved);
-    w.f64(c.last.load_factor);
-    w.vec(c.last.tool_position);
-    w.u64(c.state.size());
-    for (double v : c.state) w.f64(v);
-    w.u64(c.profile.rows.size());
-    for (const ProfileRow& r : c.profile.rows) {
-      w.f64(r.t);
-      w.str(r.tool);
-      w.vec(r.position);
-      w.vec(r.force);
-      w.i32(static_cast<std::int32_t>(r.mode));
-      w.f64(r.crack_extent);
-      w.f64(r.cost_s);
-    }
-    w.str(c.samples.dump());
-    w.f64(c.solve_seconds);
-    out.flush();
-    if (!out) throw std::runtime_error("reference: writing checkpoint " + tmp.string() + " failed");
-  });
-}
-
-Checkpoint read_checkpoint(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw std::runtime_error("reference: cannot read checkpoint " + file.string());
-  char magic[8];
-  in.read(magic, sizeof magic);
-  if (!in || !std::equal(magic, magic + 8, checkpoint_magic))
-    throw std::runtime_error("reference checkpoint " + file.string() + ": not a kerf reference checkpoint");
-  Reader r(in, file);
-  Checkpoint c;
-  c.scene_sha256 = r.str();
-  c.degree = r.pod<std::int32_t>();
-  c.refinements = r.pod<std::int32_t>();
-  c.processes = r.pod<std::int32_t>();
-  c.indices.resize(r.count(std::uint64_t{1} << 32));
-  for (std::size_t& i : c.indices) i = r.u64();
-  c.solved = r.u64();
-  c.last.load_factor = r.f64();
-  c.last.tool_position = r.vec();
-  c.state.resize(r.count(std::uint64_t{1} << 34));
-  for (double& v : c.state) v = r.f64();
-  c.profile.rows.resize(r.count(std::uint64_t{1} << 32));
-  for (ProfileRow& row : c.profile.rows) {
-    row.t = r.f64();
-    row.tool = r.str();
-    row.position = r.vec();
-    row.force = r.vec();
-    const auto mode = r.pod<std::int32_t>();
-    if (mode < 0 || mode > static_cast<std::int32_t>(InteractionMode::deformation_2))
-      throw std::runtime_error("reference checkpoint " + file.string() + ": corrupt mode");
-    row.mode = static_cast<InteractionMode>(mode);
-    row.crack_extent = r.f64();
-    row.cost_s = r.f64();
-  }
-  c.samples = nlohmann::json::parse(r.str());
-  c.solve_seconds = r.f64();
-  if (c.solved > c.indices.size())
-    throw std::runtime_error("reference checkpoint " + file.string() + ": more samples solved than requested");
-  return c;
-}
-
 // ---------------------------------------------------------------------------------- fields
 /// fields/step_NNNN.vtu, or the .pvtu record of the pieces of a distributed run.
 std::string step_name(std::size_t k, bool pieces) {
@@ -414,7 +269,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
 
   const std::string sha = file_sha256(scene.file);
   const fs::path checkpoint_file = dir / "checkpoint.bin";
-  Checkpoint cp;
+  ReferenceCheckpoint cp;
   cp.scene_sha256 = sha;
   cp.degree = settings.degree;
   cp.refinements = settings.refinements;
@@ -423,7 +278,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   cp.last = load_of(0);
   std::optional<std::size_t> resumed_from;
   if (settings.resume && fs::exists(checkpoint_file)) {
-    Checkpoint saved = read_checkpoint(checkpoint_file);
+    ReferenceCheckpoint saved = read_reference_checkpoint(checkpoint_file);
     if (saved.scene_sha256 != sha || saved.degree != settings.degree || saved.refinements != settings.refinements ||
         saved.indices != indices || saved.processes != cp.processes)
       throw std::runtime_error("reference: " + checkpoint_file.string() +
@@ -546,7 +401,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     }
     if (cp.solved % static_cast<std::size_t>(settings.checkpoint_every) == 0) {
       cp.state = path.last_converged_state();
-      if (writer) write_checkpoint(cp, checkpoint_file);
+      if (writer) write_reference_checkpoint(cp, checkpoint_file);
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - run_begin).count();
     const double eta = elapsed / static_cast<double>(cp.solved - first) * static_cast<double>(indices.size() - cp.solved);
@@ -560,7 +415,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   }
   if (!stop.empty()) {
     cp.state = path.last_converged_state();
-    if (writer) write_checkpoint(cp, checkpoint_file); // the last converged state, saved
+    if (writer) write_reference_checkpoint(cp, checkpoint_file); // the last converged state, saved
   }
 
   nlohmann::json m;

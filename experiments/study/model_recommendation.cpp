@@ -1,6 +1,7 @@
 #include "experiments/study/model_recommendation.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
@@ -37,6 +38,8 @@ std::vector<std::string> csv_fields(const std::string& line, const std::filesyst
   return out;
 }
 
+/// A measured error or cost: empty (not measured), or a finite number >= 0 ("nan" or "-inf" would
+/// pass every budget comparison in recommend_model and be recommended).
 std::optional<double> number(const std::string& field, const std::filesystem::path& file, std::size_t line) {
   if (field.empty()) return std::nullopt;
   std::size_t used = 0;
@@ -46,7 +49,8 @@ std::optional<double> number(const std::string& field, const std::filesystem::pa
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != field.size()) throw std::runtime_error(file.string() + ":" + std::to_string(line) + ": \"" + field + "\" is not a number");
+  if (used != field.size() || !std::isfinite(v) || v < 0.0)
+    throw std::runtime_error(file.string() + ":" + std::to_string(line) + ": \"" + field + "\" is not a finite number >= 0");
   return v;
 }
 

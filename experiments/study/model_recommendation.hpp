@@ -22,7 +22,7 @@ struct MeasuredRow {
 
 /// Reads the scored rows of a study.csv (columns "scene", "model", "RMS force error [%]",
 /// "p99 cost [µs]"; RFC 4180 quoting). Throws std::runtime_error naming file:line on a malformed
-/// file or missing columns.
+/// file, missing columns, or an error or cost that is neither empty nor a finite number >= 0.
 std::vector<MeasuredRow> read_study_rows(const std::filesystem::path& csv);
 
 /// Every study.csv under `directory` (recursively), or `directory` itself if it is a file; sorted.

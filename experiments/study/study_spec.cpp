@@ -4,6 +4,9 @@
 
 #include <toml++/toml.h>
 
+#include <limits>
+#include <system_error>
+
 namespace kerf {
 
 namespace {
@@ -64,8 +67,9 @@ StudySpec read_study(const std::filesystem::path& file) {
   for (const std::string& s : strings(file, *study, "scenes", "study.")) {
     const std::filesystem::path beside = file.parent_path() / s;
     const std::filesystem::path named = std::filesystem::path(KERF_SCENES_DIR) / (s + ".toml");
-    if (std::filesystem::exists(beside) && beside.extension() == ".toml") spec.scenes.push_back(beside);
-    else if (std::filesystem::exists(named)) spec.scenes.push_back(named);
+    std::error_code ec; // a name the file system cannot look up (too long) is no scene, not an exception
+    if (std::filesystem::exists(beside, ec) && beside.extension() == ".toml") spec.scenes.push_back(beside);
+    else if (std::filesystem::exists(named, ec)) spec.scenes.push_back(named);
     else fail(file, (*study)["scenes"].node()->source(), "study.scenes", "no scene \"" + s + "\" beside the study or in " + KERF_SCENES_DIR);
   }
   for (const std::string& m : strings(file, *study, "models", "study.")) {
@@ -92,7 +96,8 @@ StudySpec read_study(const std::filesystem::path& file) {
     }
     if (auto s = (*ref)["samples"]) {
       const auto v = s.value<int64_t>();
-      if (!v || *v < 2) fail(file, s.node()->source(), "reference.samples", "expected an integer >= 2");
+      if (!v || *v < 2 || *v > std::numeric_limits<int>::max())
+        fail(file, s.node()->source(), "reference.samples", "expected an integer in 2..2147483647");
       spec.reference.samples = static_cast<int>(*v);
     }
   }
@@ -109,7 +114,8 @@ StudySpec read_study(const std::filesystem::path& file) {
       for (const toml::node& n : *a) {
         const auto name = n.value<std::string>();
         const std::filesystem::path p = file.parent_path() / name.value_or("");
-        if (!name || !std::filesystem::is_regular_file(p)) fail(file, n.source(), key, "no parameter file \"" + name.value_or("") + "\" beside the study");
+        std::error_code ec;
+        if (!name || !std::filesystem::is_regular_file(p, ec)) fail(file, n.source(), key, "no parameter file \"" + name.value_or("") + "\" beside the study");
         if (calibrated_models(p).empty()) fail(file, n.source(), key, p.string() + " has no [models.*] table");
         spec.calibrations[std::string(scene.str())].push_back(p);
       }

@@ -41,7 +41,8 @@ void read_trajectory_csv(const std::filesystem::path& file, std::vector<double>&
     for (std::size_t n = 0; n < 4; ++n) {
       char* end = nullptr;
       v[n] = std::strtod(fields[n].c_str(), &end);
-      if (fields[n].empty() || *end != '\0' || !std::isfinite(v[n]))
+      // The whole field: a NUL byte inside it ends strtod's string, not the field.
+      if (fields[n].empty() || end != fields[n].c_str() + fields[n].size() || !std::isfinite(v[n]))
         throw std::runtime_error(file.string() + ":" + std::to_string(number) + ": column " + std::to_string(n + 1) +
                                  ": expected a finite number, found \"" + fields[n] + "\"");
     }
@@ -66,6 +67,11 @@ ReplayDevice::ReplayDevice(const std::filesystem::path& file, int tool, double m
     if (tool < 0 || static_cast<std::size_t>(tool) >= session.header.tools.size())
       throw std::runtime_error(file.string() + ": the session has no tool " + std::to_string(tool));
     for (const TickRecord& r : session.ticks) {
+      // Interpolation divides by the time between samples: it must be positive (a trajectory
+      // CSV is checked as it is read; a session file only orders its ticks).
+      if (!m_times.empty() && !(r.t > m_times.back()))
+        throw std::runtime_error(file.string() + ": tick " + std::to_string(r.tick) +
+                                 ": time must increase strictly for a replay");
       m_times.push_back(r.t);
       m_positions.push_back(r.tool[static_cast<std::size_t>(tool)].position);
     }
@@ -85,7 +91,12 @@ bool ReplayDevice::poll(double now) noexcept {
   // Linear interpolation between the bracketing samples, held at the ends.
   const double s =
       std::clamp((t - m_times[m_cursor]) / (m_times[m_cursor + 1] - m_times[m_cursor]), 0.0, 1.0);
-  m_state.position = m_positions[m_cursor] + s * (m_positions[m_cursor + 1] - m_positions[m_cursor]);
+  // (1 - s) p_k + s p_k+1: finite for finite samples, where p_k + s (p_k+1 - p_k) overflows when
+  // the difference does (samples near ±1.8e308 m); within an ulp of overflow, the nearer sample.
+  const Eigen::Vector3d& a = m_positions[m_cursor];
+  const Eigen::Vector3d& b = m_positions[m_cursor + 1];
+  m_state.position = (1.0 - s) * a + s * b;
+  if (!m_state.position.allFinite()) m_state.position = s < 0.5 ? a : b;
   m_state.sequence = ++m_sequence;
   m_state.received_time = now;
   m_has_state = true;

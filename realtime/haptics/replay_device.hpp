@@ -2,7 +2,7 @@
 // `replay:FILE`: a device that plays a recorded or scripted trajectory instead of a hand. FILE is
 // either a trajectory CSV (header `t,px,py,pz`, seconds and metres, strictly increasing t, the
 // format of a scene's recorded trajectory) or a kerf session file (its first tool; `replay:FILE#N`
-// picks tool N of a session). The position is linearly interpolated at the time since the first
+// picks tool N of a session; its times must increase strictly too). The position is linearly interpolated at the time since the first
 // poll and held at the last sample afterwards. Commands are accepted and kept (last_force()).
 
 #include "realtime/haptics/haptic_device.hpp"

@@ -41,7 +41,8 @@ Session read_session(const std::filesystem::path& file) {
   auto number_at = [&](const std::string& field, const char* column) {
     char* end = nullptr;
     const double v = std::strtod(field.c_str(), &end);
-    if (field.empty() || *end != '\0' || !std::isfinite(v))
+    // The whole field: a NUL byte inside it ends strtod's string, not the field.
+    if (field.empty() || end != field.c_str() + field.size() || !std::isfinite(v))
       fail(std::string("column ") + column + ": expected a finite number, found \"" + field + "\"");
     return v;
   };
@@ -50,7 +51,8 @@ Session read_session(const std::filesystem::path& file) {
   auto model_number_at = [&](const std::string& field) {
     char* end = nullptr;
     const double v = std::strtod(field.c_str(), &end);
-    if (field.empty() || *end != '\0') fail("column model_f: expected a number, found \"" + field + "\"");
+    if (field.empty() || end != field.c_str() + field.size())
+      fail("column model_f: expected a number, found \"" + field + "\"");
     return v;
   };
   // Counts and bit sets (tick, buttons, status): a whole number in [0, limit), checked before the

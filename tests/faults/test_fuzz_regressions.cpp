@@ -2,15 +2,24 @@
 // through the same harness in the normal suite (and so under ASan + UBSan in the asan stage),
 // and, for each finding, what the fixed parser now says about it.
 
+#include "experiments/calibration/calibration.hpp"
+#include "experiments/run/model_catalogue.hpp"
+#include "experiments/run/reference_checkpoint.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/model_recommendation.hpp"
+#include "experiments/study/study_spec.hpp"
 #include "experiments/trajectory/trajectory.hpp"
+#include "fuzz/catalogue_model_names.hpp"
 #include "fuzz/fuzz_targets.hpp"
+#include "realtime/haptics/replay_device.hpp"
 #include "realtime/haptics/session_file.hpp"
 
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -138,4 +147,210 @@ TEST(FuzzRegressions, NonAsciiWhereTomlExpectsWhitespaceIsASyntaxError) {
   const fs::path scene_file = scratch("clay_pull.toml");
   std::ofstream(scene_file) << text;
   EXPECT_EQ(read_scene(scene_file).description, "\xC2\xA7 5.1");
+}
+
+TEST(FuzzRegressions, CorruptReferenceCheckpointsAreErrorsNotJsonExceptionsOrHugeAllocations) {
+  // Findings (fuzz_reference_checkpoint): (1) sample records that are not JSON escaped from
+  // read_reference_checkpoint as nlohmann::json::parse_error (saved input: a control character
+  // in a key), and records of the wrong shape would have escaped run_reference's resume as
+  // nlohmann type errors, or converted a JSON number outside int with undefined behaviour;
+  // (2) a count was trusted up to 2^32 items (2^34 for the state): a 42 kB input made the reader
+  // allocate 1.2 GB (libFuzzer peak RSS, 6 inputs/s), and the saved 164-byte input asks for
+  // 2^32 - 1 indices, 32 GiB. Now a count must fit in the bytes left in the file, and the records
+  // must be what run_reference resumes from; both are std::runtime_errors naming the file.
+  const fs::path dir = regressions / "reference_checkpoint";
+  const auto message = [](const fs::path& file) { return error_of([&] { read_reference_checkpoint(file); }); };
+  EXPECT_NE(message(dir / "json_control_character.bin").find("corrupt sample records"), std::string::npos);
+  EXPECT_NE(message(dir / "huge_index_count.bin").find("corrupt count"), std::string::npos);
+
+  // A checkpoint as run_reference writes it reads back whole (the independent check: every field
+  // equal to what was written).
+  ReferenceCheckpoint c;
+  c.scene_sha256 = std::string(64, 'a');
+  c.degree = 2;
+  c.refinements = 1;
+  c.processes = 3;
+  c.indices = {0, 4, 8};
+  c.solved = 2;
+  c.last.load_factor = 0.5;
+  c.last.tool_position = {1e-3, 2e-3, 3e-3};
+  c.state = {1.0, -2.0, 3.5};
+  for (int k = 0; k < 2; ++k) {
+    ProfileRow row;
+    row.t = 0.1 * k;
+    row.tool = "stylus";
+    row.force = {0.0, 0.0, 1.5 * k};
+    row.mode = InteractionMode::deformation_1;
+    c.profile.rows.push_back(row);
+    c.samples.push_back({{"index", 4 * k}, {"newton_iterations", 3}, {"contact_points", k}});
+  }
+  c.solve_seconds = 1.25;
+  const fs::path file = scratch("checkpoint.bin");
+  write_reference_checkpoint(c, file);
+  const ReferenceCheckpoint back = read_reference_checkpoint(file);
+  EXPECT_EQ(back.scene_sha256, c.scene_sha256);
+  EXPECT_EQ(back.indices, c.indices);
+  EXPECT_EQ(back.solved, 2u);
+  EXPECT_EQ(back.state, c.state);
+  EXPECT_EQ(back.last.tool_position, c.last.tool_position);
+  ASSERT_EQ(back.profile.rows.size(), 2u);
+  EXPECT_EQ(back.profile.rows[1].force, c.profile.rows[1].force);
+  EXPECT_EQ(back.samples, c.samples);
+  EXPECT_EQ(back.solve_seconds, 1.25);
+
+  // Records run_reference could not resume from.
+  for (const nlohmann::json& bad : {nlohmann::json{{"newton_iterations", 1e300}, {"contact_points", 0}},
+                                    nlohmann::json{{"newton_iterations", "3"}, {"contact_points", 0}},
+                                    nlohmann::json{{"newton_iterations", 3}},
+                                    nlohmann::json{{"newton_iterations", 3}, {"contact_points", 0}, {"energy", 1}}}) {
+    ReferenceCheckpoint corrupt = c;
+    corrupt.samples[1] = bad;
+    write_reference_checkpoint(corrupt, file);
+    EXPECT_NE(message(file).find("corrupt sample records"), std::string::npos) << bad.dump();
+  }
+  ReferenceCheckpoint short_records = c;
+  short_records.samples.erase(1); // two solved samples, one record
+  write_reference_checkpoint(short_records, file);
+  EXPECT_NE(message(file).find("corrupt sample records"), std::string::npos);
+}
+
+TEST(FuzzRegressions, StudyWithAnUnlookableSceneNameOrSamplesPastIntIsAStudyError) {
+  // Found by reading study_spec.cpp, confirmed through fuzz_study (the 4-minute run did not reach
+  // them): (1) a scene name the file system cannot look up (300 characters: ENAMETOOLONG) escaped
+  // as std::filesystem::filesystem_error, which names no line; (2) samples = 4294967297 was
+  // accepted and converted to int as 1 (below the documented minimum of 2). Both are now
+  // StudyErrors naming file:line:column and the key.
+  const auto message = [](const fs::path& file) {
+    try {
+      read_study(file);
+    } catch (const StudyError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string name = message(regressions / "study" / "scene_name_too_long.toml");
+  EXPECT_NE(name.find("scene_name_too_long.toml:3:"), std::string::npos) << name;
+  EXPECT_NE(name.find("study.scenes: no scene"), std::string::npos) << name;
+  const std::string samples = message(regressions / "study" / "samples_past_int.toml");
+  EXPECT_NE(samples.find("samples_past_int.toml:6:"), std::string::npos) << samples;
+  EXPECT_NE(samples.find("reference.samples: expected an integer in 2..2147483647"), std::string::npos) << samples;
+  // The largest int still reads (the bound is the type's, not a smaller policy).
+  const fs::path ok = scratch("largest_samples.toml");
+  std::ofstream(ok) << "[study]\nname = \"x\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n"
+                    << "[reference]\nsamples = 2147483647\n";
+  EXPECT_EQ(read_study(ok).reference.samples, 2147483647);
+}
+
+TEST(FuzzRegressions, StudyTableWithANonFiniteOrNegativeMeasurementIsAnError) {
+  // Found by reading model_recommendation.cpp, confirmed through fuzz_study_table: "nan" in the
+  // error column (or "-inf" as a cost) read as a number, passed every budget comparison of
+  // recommend_model and was recommended ("nan %" within 10 %). A measured error or cost is now
+  // empty or a finite number >= 0; anything else is an error naming file:line.
+  for (const char* name : {"nan_error.csv", "negative_infinite_cost.csv"}) {
+    const std::string message = error_of([&] { read_study_rows(regressions / "study_table" / name); });
+    EXPECT_NE(message.find(std::string(name) + ":2: "), std::string::npos) << message;
+    EXPECT_NE(message.find("is not a finite number >= 0"), std::string::npos) << message;
+  }
+  // Zero and an empty field still read (a perfect model; a row that was not scored).
+  const fs::path ok = scratch("study.csv");
+  std::ofstream(ok) << "scene,model,RMS force error [%],p99 cost [\xC2\xB5s]\npotato,a,0,0\npotato,b,,\n";
+  const auto rows = read_study_rows(ok);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].rms_error, 0.0);
+  EXPECT_FALSE(rows[1].rms_error.has_value());
+  EXPECT_EQ(recommend_model(rows, "potato", 0.1, 1000.0).choice->model, "a");
+}
+
+TEST(FuzzRegressions, ReplayNeverGivesANonFinitePosition) {
+  // Finding (fuzz_replay, the 4-minute run): a session file whose tick 1 has the time "0.<NUL
+  // bytes>35099..." read as t = 0 (strtod stops at the NUL, and the check looked for the NUL,
+  // not the field's end), so ticks 0 and 1 had the same time; the replay divided by that zero
+  // time step and gave a NaN position, which no link check stands between it and the model.
+  // Now a number must fill its whole field (session files and replay CSVs), and a session's
+  // times must increase strictly to be replayed.
+  const std::string session = error_of([] { read_session(regressions / "replay" / "session_time_with_nul.csv"); });
+  EXPECT_NE(session.find("session_time_with_nul.csv:5: column t: expected a finite number"), std::string::npos) << session;
+  const std::string header = "# kerf haptic session v1\n# rate_hz=1000 model=m scene=s tools=a\n" +
+                             std::string(session_csv_header) + "\n";
+  const std::string row_tail = ",a,0,0,0,0,0,0,1,0,0,0,0,0,0,0,0,0,0,no-contact,0,0,0,0,0,0\n";
+  const fs::path same_time = scratch("same_time.csv");
+  std::ofstream(same_time) << header << "0,0.5" << row_tail << "1,0.5" << row_tail;
+  EXPECT_EQ(read_session(same_time).ticks.size(), 2u); // a valid session file ...
+  EXPECT_NE(error_of([&] { ReplayDevice device(same_time, 0, 8.5); }).find("tick 1: time must increase strictly"),
+            std::string::npos); // ... but not a replay
+  // Found by reading the interpolation, confirmed through fuzz_replay: finite samples whose
+  // difference overflows (1e308 m, then -1e308 m) gave NaN at the first poll (0 x -Inf). Now
+  // (1 - s) p0 + s p1, finite; and a normal replay still interpolates linearly (independent
+  // value: halfway between (0,0,0) and (2,4,6) mm at t = 0.5 s of 1 s is (1,2,3) mm).
+  ReplayDevice extreme(regressions / "replay" / "position_difference_overflows.csv", 0, 8.5);
+  for (const double now : {0.0, 0.5, 1.0, 2.0}) {
+    extreme.poll(now);
+    EXPECT_TRUE(extreme.state().position.allFinite()) << now;
+  }
+  const fs::path line = scratch("line.csv");
+  std::ofstream(line) << "t,px,py,pz\n0,0,0,0\n1,0.002,0.004,0.006\n";
+  ReplayDevice replay(line, 0, 8.5);
+  replay.poll(10.0);
+  replay.poll(10.5);
+  EXPECT_NEAR((replay.state().position - Eigen::Vector3d(0.001, 0.002, 0.003)).norm(), 0.0, 1e-15);
+}
+
+TEST(FuzzHarnesses, TheFuzzBuildsModelNamesAreTheCatalogues) {
+  // The fuzz build checks a study's models against fuzz/catalogue_model_names.hpp instead of the
+  // catalogue (which links every model builder): the two lists must be the same.
+  std::vector<std::string_view> names;
+  for (const ModelDescription& d : model_catalogue()) names.push_back(d.name);
+  EXPECT_TRUE(std::equal(names.begin(), names.end(), fuzz::catalogue_model_names.begin(),
+                         fuzz::catalogue_model_names.end()));
+}
+
+TEST(FuzzHarnesses, ParameterFilesWrittenByCalibrateReadBackThroughTheHarness) {
+  // Every parameter file `kerf calibrate` can write for a repository scene (parameter_file_text
+  // with the scene's own values) passes fuzz_parameter_file with that scene picked, and the
+  // scene read with it has the values written, to the 9 significant digits they are written with.
+  const fuzz::FuzzHarness harness = fuzz::find_harness("parameter_file");
+  ASSERT_NE(harness, nullptr);
+  std::vector<fs::path> scenes;
+  for (const auto& e : fs::directory_iterator(KERF_SCENES_DIR))
+    if (e.path().extension() == ".toml") scenes.push_back(e.path());
+  std::sort(scenes.begin(), scenes.end()); // the harness's order: the first byte is the index
+  int written = 0;
+  for (std::size_t k = 0; k < scenes.size(); ++k) {
+    const Scene scene = read_scene(scenes[k]);
+    for (const std::string model : {"fracture", "springs", "voxel"}) {
+      CalibratedParameters p;
+      try {
+        p = scene_parameters(model, scene);
+      } catch (const std::exception&) {
+        continue; // the scene has no section for the model, or the model no free parameter
+      }
+      for (double& v : p.values) v *= 1.5; // values the scene does not already have
+      const std::string text = parameter_file_text(p, "calibrated for the test\n\nby hand");
+      std::vector<std::byte> data{static_cast<std::byte>(k)};
+      for (char c : text) data.push_back(static_cast<std::byte>(c));
+      EXPECT_NO_THROW(harness(data)) << scenes[k] << " " << model;
+      const fs::path file = scratch("calibrated.toml");
+      std::ofstream(file) << text;
+      const CalibratedParameters back = scene_parameters(model, read_scene(scenes[k], {file}));
+      ASSERT_EQ(back.values.size(), p.values.size());
+      for (std::size_t i = 0; i < p.values.size(); ++i)
+        EXPECT_NEAR(back.values[i], p.values[i], 1e-8 * std::abs(p.values[i])) << scenes[k] << " " << model << " " << i;
+      ++written;
+    }
+  }
+  EXPECT_GE(written, 5); // fracture on the cutting scenes, voxel on the sponges, springs on the clay scenes
+}
+
+TEST(FuzzHarnesses, TheRepositoryStudiesPassTheStudyHarness) {
+  // The seeds of fuzz_study: every study file of the repository is accepted, as it is.
+  const fuzz::FuzzHarness harness = fuzz::find_harness("study");
+  ASSERT_NE(harness, nullptr);
+  int studies = 0;
+  for (const auto& e : fs::directory_iterator(KERF_STUDIES_DIR)) {
+    if (e.path().extension() != ".toml") continue;
+    EXPECT_NO_THROW(harness(bytes_of(e.path()))) << e.path();
+    EXPECT_NO_THROW(read_study(e.path())) << e.path();
+    ++studies;
+  }
+  EXPECT_GE(studies, 1);
 }
