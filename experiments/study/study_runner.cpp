@@ -6,7 +6,6 @@
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/reference_cache.hpp"
-#include "experiments/study/stability_sweep.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -15,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
@@ -51,6 +51,22 @@ ReferenceRunner finite_element_reference() {
             const std::filesystem::path& dir) {
     return run_reference(scene, scene_mesh(scene), study_reference_settings(spec, level, indices), dir);
   };
+}
+
+Scene calibration_scene(const Scene& scene, double speed) {
+  if (!(speed > 0.0) || !std::isfinite(speed))
+    throw std::invalid_argument("calibration trajectory of scene " + scene.name + ": speed factor must be > 0");
+  Scene s = scene;
+  for (Tool& t : s.tools) {
+    if (!t.trajectory.recorded_file.empty())
+      throw std::invalid_argument("scene " + scene.name + ": tool " + t.name + " replays a recorded trajectory (" +
+                                  t.trajectory.recorded_file.string() + "), which has no speed to change");
+    for (TrajectorySegment& segment : t.trajectory.segments) {
+      if (segment.kind == TrajectorySegment::Kind::move) segment.speed *= speed;
+      else segment.duration /= speed;
+    }
+  }
+  return s;
 }
 
 ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b) {
@@ -118,10 +134,23 @@ struct PlannedScene {
 struct FitRun {
   std::size_t scene = 0;
   StudyCalibrationFit fit;
-  std::size_t reference = 0;
+  std::optional<std::size_t> reference; ///< none when the fit is refused (`refusal`)
+  std::string refusal;                  ///< why this reference cannot be fitted to
   std::string label;
   std::filesystem::path dir;
 };
+
+/// Why the study's reference of `scene` is no target for a calibration, or "" when it is one: a
+/// cutting or tearing scene whose reference runs without fracture describes an uncut body, and a
+/// model fitted to it would fit that, not the cut.
+std::string fit_refusal(const Scene& scene, const StudyReferenceSpec& reference) {
+  const bool separates = scene.phenomena.contains(Phenomenon::cutting) || scene.phenomena.contains(Phenomenon::tearing);
+  if (separates && reference.fracture == ReferenceFracture::off)
+    return "not calibrated: scene " + scene.name +
+           " cuts or tears, and its reference runs without fracture ([reference] fracture = \"off\"): a fit to an uncut "
+           "body would not be a calibration of the cut";
+  return "";
+}
 
 /// The trajectory samples a reference solves on `scene`: `count` evenly spaced ones.
 std::vector<std::size_t> solved_samples(const Scene& scene, int count) {
@@ -241,10 +270,19 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
           model_runs.push_back({index, model, model + " (calibrated)", read_scene(scene_file, {parameters}),
                                 out / scene.name / (model + "-calibrated")});
         }
-      for (const StudyCalibrationFit& fit : spec.fits)
-        if (with_reference && fit.scene == scene_file.stem().string() && fit.model == model)
-          fit_runs.push_back({index, fit, plan_solve(scaled_scene(scene, "speed", fit.speed), spec.reference.refinements.back()),
-                              model + " (calibrated)", out / scene.name / (model + "-calibrated")});
+      for (const StudyCalibrationFit& fit : spec.fits) {
+        if (!with_reference || fit.scene != scene_file.stem().string() || fit.model != model) continue;
+        FitRun run{index, fit, std::nullopt, fit_refusal(scene, spec.reference), model + " (calibrated)",
+                   out / scene.name / (model + "-calibrated")};
+        if (run.refusal.empty()) {
+          try {
+            run.reference = plan_solve(calibration_scene(scene, fit.speed), spec.reference.refinements.back());
+          } catch (const std::invalid_argument& e) {
+            run.refusal = std::string("not calibrated: ") + e.what();
+          }
+        }
+        fit_runs.push_back(std::move(run));
+      }
     }
     scenes.push_back(std::move(planned));
   }
@@ -312,7 +350,8 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     tasks.emplace_back([&, run] {
       for (const char* f : {"profile.csv", "note.txt", "calibration.txt", "parameters.toml"}) fs::remove(run->dir / f);
       try {
-        const ReferenceSolve& target_solve = solves[run->reference];
+        if (!run->reference) throw std::runtime_error(run->refusal);
+        const ReferenceSolve& target_solve = solves[*run->reference];
         if (!fs::exists(target_solve.dir / "profile.csv"))
           throw std::runtime_error("not calibrated: its reference failed: " +
                                    (fs::exists(target_solve.dir / "error.txt") ? read_text(target_solve.dir / "error.txt") : "no profile written"));

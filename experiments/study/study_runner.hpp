@@ -81,6 +81,12 @@ std::vector<std::size_t> reference_sample_indices(std::size_t n, int count);
 /// The rows of `profile` whose sample index (row order per tool) is in `indices`.
 ForceProfile subsample(const ForceProfile& profile, const std::vector<std::size_t>& indices);
 
+/// The calibration trajectory of a fitted calibration ([[calibrate]], study_spec.hpp): `scene`
+/// with its scripted trajectory played `speed` times as fast — every move at `speed` times its
+/// speed, every hold 1/`speed` as long — the same path in 1/`speed` of the time. Throws
+/// std::invalid_argument for a tool replaying a recorded trajectory, or a speed factor <= 0.
+Scene calibration_scene(const Scene& scene, double speed);
+
 /// The rows of `a` whose tool and time (to 1e-9 s) also appear in `b`: the samples two runs have
 /// in common — a reference that stopped early (a blade pressed further than an uncut body can
 /// take) is compared on the samples it solved.

@@ -22,8 +22,9 @@
 //   [[calibrate]]                                  # optional: a calibration fitted by the study
 //   scene = "clay_pull"                            # a scene of study.scenes
 //   model = "springs"                              # a model of study.models with free parameters
-//   speed = 2.0                                    # the calibration trajectory: the scene's, every
-//                                                  # move at this factor of its speed (!= 1)
+//   speed = 2.0                                    # the calibration trajectory: the scene's played
+//                                                  # this many times as fast (!= 1): moves faster,
+//                                                  # holds shorter (study_runner.hpp)
 //   max_evaluations = 30                           # model runs of the fit (default 40)
 //   # fitted to the finest reference on the calibration trajectory, then run and scored, as
 //   # "MODEL (calibrated)", on the scene's own trajectory: held out from the fit.
@@ -57,12 +58,13 @@ struct StudyReferenceSpec {
 
 /// A calibration the study fits itself ([[calibrate]]): `model`'s free parameters
 /// (experiments/calibration/free_parameters.hpp) fitted to the finest reference level on the
-/// calibration trajectory — the scene's trajectory with every move at `speed` times its speed — and
+/// calibration trajectory — the scene's trajectory played `speed` times as fast (calibration_scene,
+/// study_runner.hpp) — and
 /// the fitted model scored on the scene's own trajectory, which the fit never saw.
 struct StudyCalibrationFit {
   std::string scene;         ///< scene name (a study scene's file stem)
   std::string model;         ///< catalogue name; fracture, springs or voxel
-  double speed = 2.0;        ///< factor on every move's speed (> 0, != 1)
+  double speed = 2.0;        ///< the calibration trajectory is played this many times as fast (> 0, != 1)
   int max_evaluations = 40;  ///< model runs per simplex search (>= 1)
 };
 

@@ -364,7 +364,7 @@ TEST(StudyRunner, AFittedCalibrationIsScoredOnTheHeldOutTrajectory) {
   fs::remove_all(dir);
   const StudySpec spec = read_study(write_study(
       "fit.toml", "[study]\nname = \"fit\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\", \"edge\"]\n"
-                  "[reference]\nrefinements = [0]\nsamples = 40\n"
+                  "[reference]\nrefinements = [0]\nsamples = 40\nfracture = \"auto\"\n"
                   "[[calibrate]]\nscene = \"potato_rect_cut\"\nmodel = \"fracture\"\nspeed = 2.0\nmax_evaluations = 10\n"));
   std::atomic<int> solves{0};
   const StudyResult r = run_study(spec, dir, fracture_as_reference(solves, 500.0));
@@ -400,7 +400,7 @@ TEST(StudyRunner, AFitAgainstAForcelessReferenceSaysWhy) {
   fs::remove_all(dir);
   const StudySpec spec = read_study(write_study(
       "fit0.toml", "[study]\nname = \"fit0\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n"
-                   "[reference]\nrefinements = [0]\nsamples = 6\n"
+                   "[reference]\nrefinements = [0]\nsamples = 6\nfracture = \"on\"\n"
                    "[[calibrate]]\nscene = \"potato_rect_cut\"\nmodel = \"fracture\"\nspeed = 0.5\n"));
   const ReferenceRunner forceless = [](const Scene& scene, const StudyReferenceSpec&, int, const std::vector<std::size_t>& indices,
                                        const fs::path&) {
@@ -420,4 +420,36 @@ TEST(StudyRunner, AFitAgainstAForcelessReferenceSaysWhy) {
   EXPECT_EQ(r.rows[1].model, "fracture (calibrated)");
   EXPECT_FALSE(r.rows[1].metrics.has_value());
   EXPECT_EQ(r.rows[1].note.rfind("not calibrated: ", 0), 0u) << r.rows[1].note;
+}
+
+TEST(StudyRunner, NoFitToTheUncutReferenceOfACuttingScene) {
+  // potato_rect_cut cuts; with [reference] fracture = "off" its reference is an uncut body, and a
+  // cutting model fitted to it would be fitted to that. The row says so, and the calibration
+  // trajectory's reference is not even solved.
+  const fs::path dir = fs::temp_directory_path() / ("kerf_test_study_fitoff_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const StudySpec spec = read_study(write_study(
+      "fitoff.toml", "[study]\nname = \"fitoff\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n"
+                     "[reference]\nrefinements = [0]\nsamples = 6\n"
+                     "[[calibrate]]\nscene = \"potato_rect_cut\"\nmodel = \"fracture\"\n"));
+  std::atomic<int> solves{0};
+  const StudyResult r = run_study(spec, dir, fracture_as_reference(solves, 500.0));
+  EXPECT_EQ(r.reference_runs, 1);
+  ASSERT_EQ(r.rows.size(), 2u);
+  EXPECT_EQ(r.rows[1].model, "fracture (calibrated)");
+  EXPECT_FALSE(r.rows[1].metrics.has_value());
+  EXPECT_EQ(r.rows[1].note.rfind("not calibrated: scene potato_rect_cut cuts or tears", 0), 0u) << r.rows[1].note;
+}
+
+TEST(StudyRunner, TheCalibrationTrajectoryIsTheSamePathPlayedFaster) {
+  // clay_pull: a 8 mm pull at 5 mm/s (1.6 s) and a 1 s hold. Played 4 times as fast: 0.4 s + 0.25 s,
+  // through the same positions (the end point, and the point half way up the pull).
+  const Scene scene = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
+  const Scene fast = calibration_scene(scene, 4.0);
+  const SampledTrajectory a = sample_scene_trajectories(scene).front(), b = sample_scene_trajectories(fast).front();
+  EXPECT_NEAR(a.duration(), 2.6, 1e-9);
+  EXPECT_NEAR(b.duration(), 0.65, 1e-9);
+  EXPECT_LT((a.samples.back().position - b.samples.back().position).norm(), 1e-12);
+  EXPECT_LT((a.samples[800].position - b.samples[200].position).norm(), 1e-9); // t = 0.8 s and 0.2 s: 4 mm up
+  EXPECT_THROW(calibration_scene(scene, 0.0), std::invalid_argument);
 }
