@@ -241,8 +241,8 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
   std::vector<ModelRun> model_runs;
   std::vector<FitRun> fit_runs;
   const bool with_reference = spec.has_reference && reference;
-  const auto plan_solve = [&](const Scene& scene, int level) {
-    ReferenceSolve solve{scene, level, solved_samples(scene, spec.reference.samples), {}, {}};
+  const auto plan_solve = [&](const Scene& scene, int level, int samples) {
+    ReferenceSolve solve{scene, level, solved_samples(scene, samples), {}, {}};
     const ReferenceCacheKey key = reference_cache_key(scene, study_reference_settings(spec.reference, level, solve.indices));
     solve.dir = out / "cache" / key.directory;
     solve.key_text = key.text;
@@ -253,7 +253,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     PlannedScene planned{read_scene(scene_file), {}};
     const Scene& scene = planned.scene;
     if (with_reference)
-      for (int level : spec.reference.refinements) planned.levels.push_back(plan_solve(scene, level));
+      for (int level : spec.reference.refinements) planned.levels.push_back(plan_solve(scene, level, spec.reference.samples));
     const std::size_t index = scenes.size();
     for (const std::string& model : spec.models) {
       try {
@@ -276,7 +276,9 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
                    out / scene.name / (model + "-calibrated")};
         if (run.refusal.empty()) {
           try {
-            run.reference = plan_solve(calibration_scene(scene, fit.speed), spec.reference.refinements.back());
+            run.reference = plan_solve(calibration_scene(scene, fit.speed),
+                                       *std::max_element(spec.reference.refinements.begin(), spec.reference.refinements.end()),
+                                       fit.samples > 0 ? fit.samples : spec.reference.samples);
           } catch (const std::invalid_argument& e) {
             run.refusal = std::string("not calibrated: ") + e.what();
           }

@@ -138,7 +138,7 @@ StudySpec read_study(const std::filesystem::path& file) {
     if (!spec.has_reference) fail(file, c->source(), "calibrate", "a fitted calibration needs the study's [reference] to fit to");
     for (const toml::node& n : *fits) {
       const toml::table& t = *n.as_table();
-      allow_only(file, t, "calibrate.", {"scene", "model", "speed", "max_evaluations"});
+      allow_only(file, t, "calibrate.", {"scene", "model", "speed", "max_evaluations", "samples"});
       StudyCalibrationFit fit;
       const auto scene = t["scene"].value<std::string>();
       bool known = false;
@@ -161,6 +161,11 @@ StudySpec read_study(const std::filesystem::path& file) {
         const auto e = v.value<int64_t>();
         if (!e || *e < 1 || *e > 100000) fail(file, v.node()->source(), "calibrate.max_evaluations", "expected an integer in 1..100000");
         fit.max_evaluations = static_cast<int>(*e);
+      }
+      if (auto v = t["samples"]) {
+        const auto n = v.value<int64_t>();
+        if (!n || *n < 2 || *n > 100000) fail(file, v.node()->source(), "calibrate.samples", "expected an integer in 2..100000");
+        fit.samples = static_cast<int>(*n);
       }
       const auto files = spec.calibrations.find(fit.scene);
       if (files != spec.calibrations.end())

@@ -26,6 +26,8 @@
 //                                                  # this many times as fast (!= 1): moves faster,
 //                                                  # holds shorter (study_runner.hpp)
 //   max_evaluations = 30                           # model runs of the fit (default 40)
+//   samples = 6                                    # reference solves on the calibration trajectory
+//                                                  # (default: [reference] samples)
 //   # fitted to the finest reference on the calibration trajectory, then run and scored, as
 //   # "MODEL (calibrated)", on the scene's own trajectory: held out from the fit.
 //
@@ -66,6 +68,7 @@ struct StudyCalibrationFit {
   std::string model;         ///< catalogue name; fracture, springs or voxel
   double speed = 2.0;        ///< the calibration trajectory is played this many times as fast (> 0, != 1)
   int max_evaluations = 40;  ///< model runs per simplex search (>= 1)
+  int samples = 0;           ///< reference solves on the calibration trajectory; 0: the study's [reference] samples
 };
 
 struct StudySpec {

@@ -258,7 +258,7 @@ TEST(StudySpec, ReadsSolverSettingsAndFittedCalibrations) {
   const StudySpec s = read_study(write_study(
       "solver.toml", "[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\", \"clay_pull\"]\nmodels = [\"fracture\", \"springs\"]\n"
                      "[reference]\nlinear_solver = \"iterative\"\nfracture = \"auto\"\n"
-                     "[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"springs\"\nspeed = 4.0\nmax_evaluations = 12\n"));
+                     "[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"springs\"\nspeed = 4.0\nmax_evaluations = 12\nsamples = 5\n"));
   EXPECT_EQ(s.reference.linear_solver, reference::LinearSolverChoice::iterative);
   EXPECT_EQ(s.reference.fracture, ReferenceFracture::automatic);
   ASSERT_EQ(s.fits.size(), 1u);
@@ -266,6 +266,7 @@ TEST(StudySpec, ReadsSolverSettingsAndFittedCalibrations) {
   EXPECT_EQ(s.fits[0].model, "springs");
   EXPECT_EQ(s.fits[0].speed, 4.0);
   EXPECT_EQ(s.fits[0].max_evaluations, 12);
+  EXPECT_EQ(s.fits[0].samples, 5);
   // Defaults: the automatic solver, no fracture (as `kerf reference`).
   const StudySpec d = read_study(write_study("solver_default.toml", "[study]\nname = \"t\"\nscenes = [\"clay_pull\"]\n"
                                                                     "models = [\"springs\"]\n[reference]\n"));
@@ -283,6 +284,7 @@ TEST(StudySpec, BadSolverSettingsAndFitsNameFileLineColumnAndKey) {
       {head + "[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"edge\"\n", ":8:9: calibrate.model"}, // no free parameters
       {head + "[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"springs\"\nspeed = 1.0\n", ":9:9: calibrate.speed"}, // not held out
       {head + "[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"springs\"\nmax_evaluations = 0\n", ":9:19: calibrate.max_evaluations"},
+      {head + "[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"springs\"\nsamples = 1\n", ":9:11: calibrate.samples"},
       {"[study]\nname = \"t\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"springs\"\n",
        ": calibrate: a fitted calibration needs the study's [reference]"},
   };
