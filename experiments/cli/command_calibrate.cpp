@@ -8,6 +8,7 @@
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/run/session_replay.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/reference_cache.hpp"
 #include "experiments/study/stability_sweep.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/study/study_table.hpp"
@@ -17,6 +18,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <sstream>
 
 namespace kerf::cli {
 
@@ -36,29 +38,23 @@ struct CalibrateOptions {
   bool fixed_exponents = false;
 };
 
-/// The reference on `scene` at level `refine`, `samples` solves, cached in `dir` under the scene
-/// file's hash and the settings.
+/// The reference on `scene` at level `refine`, `samples` solves, cached in `dir` under the key of
+/// the scene, its trajectory and the solver settings (reference_cache.hpp), written as dir/key.txt.
 ForceProfile reference_profile(const Scene& scene, int refine, int samples, const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
-  std::string key = file_sha256(scene.file).substr(0, 16) + " L" + std::to_string(refine) + " n" + std::to_string(samples);
-  for (const Tool& t : scene.tools) {
-    const SampledTrajectory s = sample(t.trajectory);
-    char motion[160];
-    std::snprintf(motion, sizeof motion, " %s:%zu:%.9g,%.9g,%.9g", t.name.c_str(), s.samples.size(),
-                  s.samples.back().position.x(), s.samples.back().position.y(), s.samples.back().position.z());
-    key += motion;
-  }
-  std::string cached;
-  if (std::ifstream k(dir / "key.txt"); k) std::getline(k, cached);
-  if (cached == key && fs::exists(dir / "profile.csv")) return read_profile_csv(dir / "profile.csv");
   StudyReferenceSpec spec;
   spec.refinements = {refine};
   spec.samples = samples;
   std::size_t n = 0;
   for (const auto& t : sample_scene_trajectories(scene)) n = std::max(n, t.samples.size());
-  ForceProfile p = finite_element_reference()(scene, spec, refine, reference_sample_indices(n, samples), dir);
+  const std::vector<std::size_t> indices = reference_sample_indices(n, samples);
+  const ReferenceCacheKey key = reference_cache_key(scene, study_reference_settings(spec, refine, indices));
+  std::ostringstream cached;
+  if (std::ifstream k(dir / "key.txt"); k) cached << k.rdbuf();
+  if (cached.str() == key.text && fs::exists(dir / "profile.csv")) return read_profile_csv(dir / "profile.csv");
+  ForceProfile p = finite_element_reference()(scene, spec, refine, indices, dir);
   if (!fs::exists(dir / "profile.csv")) write_profile_csv(p, dir / "profile.csv");
-  write_atomically(dir / "key.txt", [&](const fs::path& tmp) { std::ofstream(tmp) << key << '\n'; });
+  write_atomically(dir / "key.txt", [&](const fs::path& tmp) { std::ofstream(tmp) << key.text; });
   return p;
 }
 

@@ -263,8 +263,10 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   solver_settings.linear_solver = settings.linear_solver;
   solver_settings.distribute = settings.distribute;
   reference::FiniteStrainSolver solver(rp.problem, solver_settings);
-  // Under mpirun every process runs this function; rank 0 writes the files and the progress.
-  const bool writer = reference::mpi_processes().rank == 0;
+  // Under mpirun every process runs this function; rank 0 writes the files and the progress. A
+  // solver that is not distributed (settings.distribute false: e.g. one of the solves `mpirun kerf
+  // study` spreads over its ranks) is its own process's run, and that process writes.
+  const bool writer = solver.process_count() == 1 || reference::mpi_processes().rank == 0;
   const bool pieces = solver.process_count() > 1;
 
   const std::string sha = file_sha256(scene.file);

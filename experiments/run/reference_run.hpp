@@ -91,7 +91,8 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh);
 /// refinement, sample set or process count).
 ///
 /// Under `mpirun -np N`: collective (every process calls it and gets the same profile); rank 0
-/// alone writes profile.csv, manifest.json, checkpoint.bin and fields.pvd and prints the progress;
+/// alone writes profile.csv, manifest.json, checkpoint.bin and fields.pvd and prints the progress
+/// (with `distribute` false the call is this process's own, and it writes);
 /// distributed fields are fields/step_NNNN.pvtu with one .vtu piece per process.
 ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings,
                            const std::filesystem::path& dir);

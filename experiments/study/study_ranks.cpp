@@ -1,5 +1,7 @@
 #include "experiments/study/study_ranks.hpp"
 
+#include "reference/mpi_processes.hpp"
+
 #include <mpi.h>
 
 #include <cstdlib>
@@ -29,6 +31,10 @@ StudyRanks::StudyRanks() {
   }
   MPI_Comm_rank(MPI_COMM_WORLD, &m_rank);
   MPI_Comm_size(MPI_COMM_WORLD, &m_size);
+  // PETSc's initialisation is collective over MPI_COMM_WORLD, and a reference solve initialises it
+  // on first use (reference/mpi_processes.hpp) — on one rank only, the others would never join.
+  // Every rank initialises it here, together, before any run.
+  if (m_size > 1) reference::initialize_petsc();
 }
 
 StudyExecution StudyRanks::execution(int jobs) const {

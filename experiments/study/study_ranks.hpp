@@ -9,9 +9,11 @@ namespace kerf {
 
 /// This process's place among the ranks of an MPI launch. MPI is initialised only when an MPI
 /// launcher started the process (Open MPI's OMPI_COMM_WORLD_SIZE, or PMI_SIZE, in the
-/// environment); a plain `kerf study` is one rank and never touches MPI. MPI_Finalize is registered
-/// with std::atexit at initialisation, before PETSc registers its own finaliser on first use
-/// (reference/tangent_solver.cpp), so PETSc finalises first (atexit runs in reverse order).
+/// environment); a plain `kerf study` is one rank and never touches MPI. With more than one rank,
+/// every rank then initialises PETSc together (its initialisation is collective over
+/// MPI_COMM_WORLD; a reference solve on one rank would otherwise initialise it alone and wait for
+/// the others). MPI_Finalize is registered with std::atexit before PETSc registers its own
+/// finaliser (reference/mpi_processes.cpp), so PETSc finalises first (atexit runs in reverse order).
 class StudyRanks {
 public:
   StudyRanks();

@@ -1,9 +1,11 @@
 #include "experiments/study/study_runner.hpp"
 
+#include "experiments/calibration/calibration.hpp"
 #include "experiments/run/model_catalogue.hpp"
 #include "experiments/run/reference_run.hpp"
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/reference_cache.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -12,12 +14,14 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <mutex>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 namespace kerf {
 
@@ -45,13 +49,24 @@ ForceProfile subsample(const ForceProfile& profile, const std::vector<std::size_
 ReferenceRunner finite_element_reference() {
   return [](const Scene& scene, const StudyReferenceSpec& spec, int level, const std::vector<std::size_t>& indices,
             const std::filesystem::path& dir) {
-    ReferenceRunSettings settings;
-    settings.degree = spec.degree;
-    settings.refinements = level;
-    settings.sample_indices = indices;
-    settings.write_fields = false;
-    return run_reference(scene, scene_mesh(scene), settings, dir);
+    return run_reference(scene, scene_mesh(scene), study_reference_settings(spec, level, indices), dir);
   };
+}
+
+Scene calibration_scene(const Scene& scene, double speed) {
+  if (!(speed > 0.0) || !std::isfinite(speed))
+    throw std::invalid_argument("calibration trajectory of scene " + scene.name + ": speed factor must be > 0");
+  Scene s = scene;
+  for (Tool& t : s.tools) {
+    if (!t.trajectory.recorded_file.empty())
+      throw std::invalid_argument("scene " + scene.name + ": tool " + t.name + " replays a recorded trajectory (" +
+                                  t.trajectory.recorded_file.string() + "), which has no speed to change");
+    for (TrajectorySegment& segment : t.trajectory.segments) {
+      if (segment.kind == TrajectorySegment::Kind::move) segment.speed *= speed;
+      else segment.duration /= speed;
+    }
+  }
+  return s;
 }
 
 ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b) {
@@ -83,17 +98,12 @@ std::optional<SteadyCuttingExpectation> expected_cutting(const Scene& scene) {
                                   scene.tools.front().blade.cutting_direction};
 }
 
-std::string cache_key(const Scene& scene, const StudyReferenceSpec& r, int level) {
-  return file_sha256(scene.file).substr(0, 16) + "-p" + std::to_string(r.degree) + "-L" + std::to_string(level) + "-n" +
-         std::to_string(r.samples);
-}
-
 } // namespace
 
 namespace {
 
 /// One fast-model run of a study: the model on a scene (with calibrated parameters for a
-/// "MODEL (calibrated)" row), its profile under `dir`.
+/// "MODEL (calibrated)" row from a [calibration] file), its profile under `dir`.
 struct ModelRun {
   std::size_t scene = 0;  ///< index into the planned scenes
   std::string model;      ///< catalogue name
@@ -102,11 +112,52 @@ struct ModelRun {
   std::filesystem::path dir;
 };
 
+/// One reference solve: a scene (possibly with another trajectory than its file's) at a mesh level
+/// on chosen samples, cached in `dir` (reference_cache.hpp).
+struct ReferenceSolve {
+  Scene scene;
+  int level = 0;
+  std::vector<std::size_t> indices;
+  std::filesystem::path dir;
+  std::string key_text;
+};
+
 struct PlannedScene {
   Scene scene;
-  std::vector<std::size_t> indices; ///< trajectory samples the reference solves
-  std::vector<std::pair<int, std::filesystem::path>> levels; ///< (mesh level, cache directory)
+  std::vector<std::size_t> levels; ///< indices into the planned reference solves, coarsest first
 };
+
+/// A calibration the study fits ([[calibrate]]): the fit on the calibration trajectory against
+/// `reference` (an index into the planned solves), then the fitted model on the scene's own
+/// trajectory, written under `dir` like any model run, with `parameters.toml` and
+/// `calibration.txt` (the row's note) beside.
+struct FitRun {
+  std::size_t scene = 0;
+  StudyCalibrationFit fit;
+  std::optional<std::size_t> reference; ///< none when the fit is refused (`refusal`)
+  std::string refusal;                  ///< why this reference cannot be fitted to
+  std::string label;
+  std::filesystem::path dir;
+};
+
+/// Why the study's reference of `scene` is no target for a calibration, or "" when it is one: a
+/// cutting or tearing scene whose reference runs without fracture describes an uncut body, and a
+/// model fitted to it would fit that, not the cut.
+std::string fit_refusal(const Scene& scene, const StudyReferenceSpec& reference) {
+  const bool separates = scene.phenomena.contains(Phenomenon::cutting) || scene.phenomena.contains(Phenomenon::tearing);
+  if (separates && reference.fracture == ReferenceFracture::off)
+    return "not calibrated: scene " + scene.name +
+           " cuts or tears, and its reference runs without fracture ([reference] fracture = \"off\"): a fit to an uncut "
+           "body would not be a calibration of the cut";
+  return "";
+}
+
+/// The trajectory samples a reference solves on `scene`: `count` evenly spaced ones.
+std::vector<std::size_t> solved_samples(const Scene& scene, int count) {
+  std::size_t n = 0;
+  for (const auto& t : sample_scene_trajectories(scene)) n = std::max(n, t.samples.size());
+  return reference_sample_indices(n, count);
+}
 
 void write_text(const std::filesystem::path& file, const std::string& text) {
   std::filesystem::create_directories(file.parent_path());
@@ -147,6 +198,34 @@ void run_tasks(const std::vector<std::function<void()>>& tasks, int jobs) {
   if (failure) std::rethrow_exception(failure);
 }
 
+/// "stiffness_scale 1 → 0.62": each free parameter from its start to its fitted value, in the
+/// units of its parameter file, and the fracture exponents.
+std::string describe_fit(const CalibrationResult& r) {
+  std::string out;
+  const auto free = free_parameters(r.fitted.model);
+  for (std::size_t k = 0; k < free.size(); ++k) {
+    char item[160];
+    std::snprintf(item, sizeof item, "%s%s %.4g → %.4g%s%s", out.empty() ? "" : ", ", std::string(free[k].symbol).c_str(),
+                  r.initial.values[k] / free[k].unit_value, r.fitted.values[k] / free[k].unit_value,
+                  free[k].unit.empty() ? "" : " ", std::string(free[k].unit).c_str());
+    out += item;
+  }
+  if (r.fitted.deformation_1_exponent) out += ", i = " + std::to_string(*r.fitted.deformation_1_exponent);
+  if (r.fitted.deformation_2_exponent) out += ", j = " + std::to_string(*r.fitted.deformation_2_exponent);
+  return out;
+}
+
+/// Runs `model` on `scene` and writes its profile and manifest under `dir`.
+void run_and_write(const std::string& model, const Scene& scene, const TetMesh& mesh, const std::filesystem::path& dir) {
+  BuiltModel built = make_model(model, scene, mesh);
+  std::vector<std::string> names;
+  for (const Tool& t : scene.tools) names.push_back(t.name);
+  const auto begin = std::chrono::steady_clock::now();
+  const ForceProfile profile = run_model(*built.model, names, sample_scene_trajectories(scene));
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  write_run(dir, profile, run_manifest(scene, built, mesh, profile, wall));
+}
+
 } // namespace
 
 StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
@@ -156,18 +235,25 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     throw std::invalid_argument("run_study: " + std::to_string(execution.ranks) + " ranks need a synchronise function");
   const auto synchronise = [&](int value) { return execution.ranks > 1 ? execution.synchronise(value) : value; };
 
-  // Plan (every rank the same): scenes, reference levels not yet cached, model runs.
+  // Plan (every rank the same): scenes, reference solves, model runs, fitted calibrations.
   std::vector<PlannedScene> scenes;
+  std::vector<ReferenceSolve> solves;
   std::vector<ModelRun> model_runs;
+  std::vector<FitRun> fit_runs;
+  const bool with_reference = spec.has_reference && reference;
+  const auto plan_solve = [&](const Scene& scene, int level, int samples) {
+    ReferenceSolve solve{scene, level, solved_samples(scene, samples), {}, {}};
+    const ReferenceCacheKey key = reference_cache_key(scene, study_reference_settings(spec.reference, level, solve.indices));
+    solve.dir = out / "cache" / key.directory;
+    solve.key_text = key.text;
+    solves.push_back(std::move(solve));
+    return solves.size() - 1;
+  };
   for (const fs::path& scene_file : spec.scenes) {
-    PlannedScene planned{read_scene(scene_file), {}, {}};
+    PlannedScene planned{read_scene(scene_file), {}};
     const Scene& scene = planned.scene;
-    std::size_t n = 0;
-    for (const auto& t : sample_scene_trajectories(scene)) n = std::max(n, t.samples.size());
-    planned.indices = reference_sample_indices(n, spec.reference.samples);
-    if (spec.has_reference && reference)
-      for (int level : spec.reference.refinements)
-        planned.levels.emplace_back(level, out / "cache" / cache_key(scene, spec.reference, level));
+    if (with_reference)
+      for (int level : spec.reference.refinements) planned.levels.push_back(plan_solve(scene, level, spec.reference.samples));
     const std::size_t index = scenes.size();
     for (const std::string& model : spec.models) {
       try {
@@ -177,49 +263,70 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       }
       model_runs.push_back({index, model, model, scene, out / scene.name / model});
       const auto calibrated = spec.calibrations.find(scene_file.stem().string());
-      if (calibrated == spec.calibrations.end()) continue;
-      for (const fs::path& parameters : calibrated->second) {
-        const auto models = calibrated_models(parameters);
-        if (std::find(models.begin(), models.end(), model) == models.end()) continue;
-        model_runs.push_back({index, model, model + " (calibrated)", read_scene(scene_file, {parameters}),
-                              out / scene.name / (model + "-calibrated")});
+      if (calibrated != spec.calibrations.end())
+        for (const fs::path& parameters : calibrated->second) {
+          const auto models = calibrated_models(parameters);
+          if (std::find(models.begin(), models.end(), model) == models.end()) continue;
+          model_runs.push_back({index, model, model + " (calibrated)", read_scene(scene_file, {parameters}),
+                                out / scene.name / (model + "-calibrated")});
+        }
+      for (const StudyCalibrationFit& fit : spec.fits) {
+        if (!with_reference || fit.scene != scene_file.stem().string() || fit.model != model) continue;
+        FitRun run{index, fit, std::nullopt, fit_refusal(scene, spec.reference), model + " (calibrated)",
+                   out / scene.name / (model + "-calibrated")};
+        if (run.refusal.empty()) {
+          try {
+            run.reference = plan_solve(calibration_scene(scene, fit.speed),
+                                       *std::max_element(spec.reference.refinements.begin(), spec.reference.refinements.end()),
+                                       fit.samples > 0 ? fit.samples : spec.reference.samples);
+          } catch (const std::invalid_argument& e) {
+            run.refusal = std::string("not calibrated: ") + e.what();
+          }
+        }
+        fit_runs.push_back(std::move(run));
       }
     }
     scenes.push_back(std::move(planned));
   }
-  std::vector<std::pair<std::size_t, std::size_t>> reference_runs; // (scene, level index) not cached
-  for (std::size_t s = 0; s < scenes.size(); ++s)
-    for (std::size_t l = 0; l < scenes[s].levels.size(); ++l)
-      if (!fs::exists(scenes[s].levels[l].second / "profile.csv")) reference_runs.emplace_back(s, l);
+  std::vector<std::size_t> reference_runs; // solves not cached
+  for (std::size_t k = 0; k < solves.size(); ++k)
+    if (!fs::exists(solves[k].dir / "profile.csv")) reference_runs.push_back(k);
   synchronise(0); // every rank has looked at the cache before any rank writes to it
 
-  // This rank's share: run k (references first, then models) belongs to rank k mod ranks.
+  // This rank's share: run k (references first, then models, then fits) belongs to rank k mod ranks.
   const auto mine = [&](std::size_t k) { return static_cast<int>(k % static_cast<std::size_t>(execution.ranks)) == execution.rank; };
-  std::vector<std::pair<std::size_t, std::size_t>> my_references;
+  std::vector<std::size_t> my_references;
   for (std::size_t k = 0; k < reference_runs.size(); ++k)
     if (mine(k)) my_references.push_back(reference_runs[k]);
   std::vector<const ModelRun*> my_models;
   for (std::size_t k = 0; k < model_runs.size(); ++k)
     if (mine(reference_runs.size() + k)) my_models.push_back(&model_runs[k]);
+  std::vector<const FitRun*> my_fits;
+  for (std::size_t k = 0; k < fit_runs.size(); ++k)
+    if (mine(reference_runs.size() + model_runs.size() + k)) my_fits.push_back(&fit_runs[k]);
 
   // Meshes of the scenes this rank runs models on, made before the threads start.
   std::map<std::size_t, TetMesh> meshes;
   for (const ModelRun* run : my_models)
     if (!meshes.count(run->scene)) meshes.emplace(run->scene, scene_mesh(scenes[run->scene].scene));
+  for (const FitRun* run : my_fits)
+    if (!meshes.count(run->scene)) meshes.emplace(run->scene, scene_mesh(scenes[run->scene].scene));
 
+  // Phase 1: the reference solves and the model runs.
   std::vector<std::function<void()>> tasks;
   int solved = 0;
   if (!my_references.empty())
     tasks.emplace_back([&] { // one at a time: PETSc is not thread-safe
-      for (const auto& [s, l] : my_references) {
-        const auto& [level, cached] = scenes[s].levels[l];
-        fs::remove(cached / "error.txt");
+      for (std::size_t k : my_references) {
+        const ReferenceSolve& solve = solves[k];
+        fs::remove(solve.dir / "error.txt");
         try {
-          const ForceProfile p = reference(scenes[s].scene, spec.reference, level, scenes[s].indices, cached);
-          if (!fs::exists(cached / "profile.csv")) write_profile_csv(p, cached / "profile.csv");
+          const ForceProfile p = reference(solve.scene, spec.reference, solve.level, solve.indices, solve.dir);
+          if (!fs::exists(solve.dir / "profile.csv")) write_profile_csv(p, solve.dir / "profile.csv");
+          write_text(solve.dir / "key.txt", solve.key_text);
           ++solved;
         } catch (const std::exception& e) {
-          write_text(cached / "error.txt", e.what());
+          write_text(solve.dir / "error.txt", e.what());
         }
       }
     });
@@ -228,14 +335,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       fs::remove(run->dir / "profile.csv");
       fs::remove(run->dir / "note.txt");
       try {
-        const TetMesh& mesh = meshes.at(run->scene);
-        BuiltModel built = make_model(run->model, run->scene_with_parameters, mesh);
-        std::vector<std::string> names;
-        for (const Tool& t : run->scene_with_parameters.tools) names.push_back(t.name);
-        const auto begin = std::chrono::steady_clock::now();
-        const ForceProfile profile = run_model(*built.model, names, sample_scene_trajectories(run->scene_with_parameters));
-        const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-        write_run(run->dir, profile, run_manifest(run->scene_with_parameters, built, mesh, profile, wall));
+        run_and_write(run->model, run->scene_with_parameters, meshes.at(run->scene), run->dir);
       } catch (const std::exception& e) {
         write_text(run->dir / "note.txt", e.what());
       }
@@ -243,18 +343,65 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
   run_tasks(tasks, execution.jobs);
 
   StudyResult result;
-  result.reference_runs = synchronise(solved);
+  result.reference_runs = synchronise(solved); // every reference is on disk: the fits may read theirs
+
+  // Phase 2: the fitted calibrations, each against its reference on the calibration trajectory,
+  // then scored on the scene's own trajectory.
+  tasks.clear();
+  for (const FitRun* run : my_fits)
+    tasks.emplace_back([&, run] {
+      for (const char* f : {"profile.csv", "note.txt", "calibration.txt", "parameters.toml"}) fs::remove(run->dir / f);
+      try {
+        if (!run->reference) throw std::runtime_error(run->refusal);
+        const ReferenceSolve& target_solve = solves[*run->reference];
+        if (!fs::exists(target_solve.dir / "profile.csv"))
+          throw std::runtime_error("not calibrated: its reference failed: " +
+                                   (fs::exists(target_solve.dir / "error.txt") ? read_text(target_solve.dir / "error.txt") : "no profile written"));
+        char speed[32];
+        std::snprintf(speed, sizeof speed, "%g", run->fit.speed);
+        const std::string label = "reference L" + std::to_string(target_solve.level) + " at speed ×" + speed;
+        const CalibrationTarget target{label, target_solve.scene, read_profile_csv(target_solve.dir / "profile.csv")};
+        CalibrationSettings settings;
+        settings.simplex.max_evaluations = run->fit.max_evaluations;
+        // 1e-3 in ln p: 0.1 % of each value, far below the reference's own discretisation error
+        // (the reference L<k> rows), which bounds what a fit to it can mean.
+        settings.simplex.step_tolerance = 1e-3;
+        const TetMesh& mesh = meshes.at(run->scene);
+        CalibrationResult fitted;
+        try {
+          fitted = calibrate(run->fit.model, target, mesh, settings);
+        } catch (const std::exception& e) {
+          throw std::runtime_error(std::string("not calibrated: ") + e.what());
+        }
+        const Scene& scene = scenes[run->scene].scene;
+        char errors[160];
+        std::snprintf(errors, sizeof errors, "RMS error there %.3g %% → %.3g %%, %d runs%s", 100.0 * fitted.initial_error,
+                      100.0 * fitted.fitted_error, fitted.evaluations, fitted.converged ? "" : ", evaluation limit reached");
+        const std::string note = "fitted at speed ×" + std::string(speed) + " to " + target_solve.scene.name + "'s " + label.substr(0, label.find(" at")) +
+                                 ": " + describe_fit(fitted) + " (" + errors + ")";
+        run_and_write(run->fit.model, with_parameters(scene, fitted.fitted), mesh, run->dir);
+        write_text(run->dir / "parameters.toml",
+                   parameter_file_text(fitted.fitted, "Fitted by kerf study " + spec.name + " ([[calibrate]] " + run->fit.model + " on " +
+                                                          scene.name + "): " + note + "\n"));
+        write_text(run->dir / "calibration.txt", note);
+      } catch (const std::exception& e) {
+        write_text(run->dir / "note.txt", e.what());
+      }
+    });
+  run_tasks(tasks, execution.jobs);
+  synchronise(0);
   if (execution.rank != 0) return result;
 
   // Rank 0: the table, from what every rank wrote.
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     const Scene& scene = scenes[s].scene;
     std::map<int, ForceProfile> references;
-    for (const auto& [level, cached] : scenes[s].levels) {
-      if (!fs::exists(cached / "profile.csv"))
-        throw std::runtime_error("reference of scene " + scene.name + " at level " + std::to_string(level) + " failed: " +
-                                 (fs::exists(cached / "error.txt") ? read_text(cached / "error.txt") : "no profile written"));
-      references[level] = read_profile_csv(cached / "profile.csv");
+    for (std::size_t k : scenes[s].levels) {
+      const ReferenceSolve& solve = solves[k];
+      if (!fs::exists(solve.dir / "profile.csv"))
+        throw std::runtime_error("reference of scene " + scene.name + " at level " + std::to_string(solve.level) + " failed: " +
+                                 (fs::exists(solve.dir / "error.txt") ? read_text(solve.dir / "error.txt") : "no profile written"));
+      references[solve.level] = read_profile_csv(solve.dir / "profile.csv");
     }
     const ForceProfile* finest = references.empty() ? nullptr : &references.rbegin()->second;
     const std::string tool = scene.tools.front().name;
@@ -271,16 +418,24 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       result.rows.push_back(std::move(row));
     }
 
+    // The model rows, each fitted calibration right after its model's plain row.
+    std::vector<std::tuple<std::string, fs::path, bool>> rows; // label, dir, fitted
     for (const ModelRun& run : model_runs) {
       if (run.scene != s) continue;
-      StudyRow row{scene.name, run.label, std::nullopt, {}, ""};
-      if (!fs::exists(run.dir / "profile.csv")) {
-        row.note = fs::exists(run.dir / "note.txt") ? read_text(run.dir / "note.txt") : "no profile written";
+      rows.emplace_back(run.label, run.dir, false);
+      for (const FitRun& fit : fit_runs)
+        if (fit.scene == s && fit.fit.model == run.model && run.label == run.model) rows.emplace_back(fit.label, fit.dir, true);
+    }
+    for (const auto& [label, dir, fitted] : rows) {
+      StudyRow row{scene.name, label, std::nullopt, {}, ""};
+      if (!fs::exists(dir / "profile.csv")) {
+        row.note = fs::exists(dir / "note.txt") ? read_text(dir / "note.txt") : "no profile written";
         result.rows.push_back(std::move(row));
         continue;
       }
+      if (fitted) row.note = read_text(dir / "calibration.txt");
       try {
-        const ForceProfile profile = read_profile_csv(run.dir / "profile.csv");
+        const ForceProfile profile = read_profile_csv(dir / "profile.csv");
         row.cost = cost_statistics(profile);
         if (finest)
           row.metrics = compare_profiles(at_common_times(profile, *finest), at_common_times(*finest, profile), tool,

@@ -25,8 +25,8 @@ using ReferenceRunner = std::function<ForceProfile(const Scene& scene, const Stu
                                                    const std::filesystem::path& dir)>;
 
 /// The finite-element reference (reference/, through experiments/run/reference_run.hpp) as a
-/// study calls it: the chosen samples at the given mesh level, no field files (`kerf reference`
-/// writes those).
+/// study calls it: the chosen samples at the given mesh level with the study's solver settings
+/// (study_reference_settings, reference_cache.hpp), no field files (`kerf reference` writes those).
 ReferenceRunner finite_element_reference();
 
 /// One row of the study table.
@@ -45,25 +45,31 @@ struct StudyResult {
 };
 
 /// How the independent runs of a study are spread: over `jobs` threads of this process and over
-/// `ranks` processes (MPI, study_ranks.hpp). A run is a reference solve (scene, mesh level) or a
-/// fast model on a scene; run k (references first, then models, in study order) belongs to rank
-/// k mod ranks. Each rank runs its share, writing every result to disk (the reference cache, the
-/// model's profile.csv, or a note.txt saying why it failed); after `synchronise`, rank 0 reads them
-/// all back and builds the table — so the tables do not depend on jobs or ranks, apart from the
-/// cost columns (a step timed beside another run is slower). Reference solves of one process run
-/// one at a time (PETSc is not thread-safe), beside the fast models.
+/// `ranks` processes (MPI, study_ranks.hpp). A run is a reference solve (a scene at a mesh level,
+/// or a scene on a calibration trajectory), a fast model on a scene, or a fitted calibration
+/// ([[calibrate]]); run k (references first, then models, then fits, in study order) belongs to
+/// rank k mod ranks. Each rank runs its share, writing every result to disk (the reference cache,
+/// the model's profile.csv, or a note.txt saying why it failed); the fits start once every
+/// reference is on disk (they read theirs from the cache); after the last `synchronise`, rank 0
+/// reads every result back and builds the table — so the tables do not depend on jobs or ranks,
+/// apart from the cost columns (a step timed beside another run is slower). Reference solves of
+/// one process run one at a time (PETSc is not thread-safe), beside the fast models; each solve
+/// runs on its one process (the mesh is not distributed).
 struct StudyExecution {
   int jobs = 1;   ///< threads for this process's runs, >= 1
   int rank = 0;   ///< this process, in [0, ranks)
   int ranks = 1;  ///< processes sharing the study
   /// With ranks > 1: waits for every rank and returns the sum of `value` over the ranks
-  /// (MPI_Allreduce). Called twice: before any run (so every rank plans from the same cache) and
-  /// after this rank's share.
+  /// (MPI_Allreduce). Called three times: before any run (so every rank plans from the same
+  /// cache), after the reference solves and model runs (summing the solves), after the fits.
   std::function<int(int value)> synchronise;
 };
 
-/// `reference` may be empty (no reference built): then only costs are reported. Every output
-/// goes under `out`; the reference cache lives in `out/cache`. Rank 0 returns the rows; other
+/// `reference` may be empty (no reference built): then only costs are reported (and nothing is
+/// fitted). Every output goes under `out`; the reference cache lives in `out/cache`, one directory
+/// per solve named by reference_cache_key (reference_cache.hpp) with its `key.txt`. A fitted
+/// calibration's row "MODEL (calibrated)" comes right after MODEL's row, its note saying what was
+/// fitted on which trajectory; its parameter file is `out/SCENE/MODEL-calibrated/parameters.toml`. Rank 0 returns the rows; other
 /// ranks return no rows (and the total reference runs). Throws if a reference solve failed.
 StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
                       const StudyExecution& execution = {});
@@ -74,6 +80,12 @@ std::vector<std::size_t> reference_sample_indices(std::size_t n, int count);
 
 /// The rows of `profile` whose sample index (row order per tool) is in `indices`.
 ForceProfile subsample(const ForceProfile& profile, const std::vector<std::size_t>& indices);
+
+/// The calibration trajectory of a fitted calibration ([[calibrate]], study_spec.hpp): `scene`
+/// with its scripted trajectory played `speed` times as fast — every move at `speed` times its
+/// speed, every hold 1/`speed` as long — the same path in 1/`speed` of the time. Throws
+/// std::invalid_argument for a tool replaying a recorded trajectory, or a speed factor <= 0.
+Scene calibration_scene(const Scene& scene, double speed);
 
 /// The rows of `a` whose tool and time (to 1e-9 s) also appear in `b`: the samples two runs have
 /// in common — a reference that stopped early (a blade pressed further than an uncut body can

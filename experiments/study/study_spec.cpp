@@ -1,9 +1,11 @@
 #include "experiments/study/study_spec.hpp"
 
+#include "experiments/calibration/free_parameters.hpp"
 #include "experiments/run/model_catalogue.hpp"
 
 #include <toml++/toml.h>
 
+#include <algorithm>
 #include <limits>
 #include <system_error>
 
@@ -56,7 +58,7 @@ StudySpec read_study(const std::filesystem::path& file) {
   }
   StudySpec spec;
   spec.file = file;
-  allow_only(file, doc, "", {"study", "reference", "calibration"});
+  allow_only(file, doc, "", {"study", "reference", "calibration", "calibrate"});
   const toml::table* study = doc["study"].as_table();
   if (!study) throw StudyError(file.string() + ": missing table [study]");
   allow_only(file, *study, "study.", {"name", "description", "scenes", "models"});
@@ -78,7 +80,7 @@ StudySpec read_study(const std::filesystem::path& file) {
   }
   if (const toml::table* ref = doc["reference"].as_table()) {
     spec.has_reference = true;
-    allow_only(file, *ref, "reference.", {"degree", "refinements", "samples"});
+    allow_only(file, *ref, "reference.", {"degree", "refinements", "samples", "linear_solver", "fracture"});
     if (auto d = (*ref)["degree"]) {
       const auto v = d.value<int64_t>();
       if (!v || (*v != 1 && *v != 2)) fail(file, d.node()->source(), "reference.degree", "expected 1 or 2");
@@ -100,6 +102,20 @@ StudySpec read_study(const std::filesystem::path& file) {
         fail(file, s.node()->source(), "reference.samples", "expected an integer in 2..2147483647");
       spec.reference.samples = static_cast<int>(*v);
     }
+    if (auto s = (*ref)["linear_solver"]) {
+      const auto v = s.value<std::string>();
+      if (v == "auto") spec.reference.linear_solver = reference::LinearSolverChoice::automatic;
+      else if (v == "direct") spec.reference.linear_solver = reference::LinearSolverChoice::direct;
+      else if (v == "iterative") spec.reference.linear_solver = reference::LinearSolverChoice::iterative;
+      else fail(file, s.node()->source(), "reference.linear_solver", "expected \"auto\", \"direct\" or \"iterative\"");
+    }
+    if (auto s = (*ref)["fracture"]) {
+      const auto v = s.value<std::string>();
+      if (v == "off") spec.reference.fracture = ReferenceFracture::off;
+      else if (v == "auto") spec.reference.fracture = ReferenceFracture::automatic;
+      else if (v == "on") spec.reference.fracture = ReferenceFracture::on;
+      else fail(file, s.node()->source(), "reference.fracture", "expected \"off\", \"auto\" or \"on\"");
+    }
   }
   if (const toml::node* c = doc.get("calibration")) {
     const toml::table* cal = c->as_table();
@@ -119,6 +135,55 @@ StudySpec read_study(const std::filesystem::path& file) {
         if (calibrated_models(p).empty()) fail(file, n.source(), key, p.string() + " has no [models.*] table");
         spec.calibrations[std::string(scene.str())].push_back(p);
       }
+    }
+  }
+  if (const toml::node* c = doc.get("calibrate")) {
+    const toml::array* fits = c->as_array();
+    if (!fits || !fits->is_array_of_tables()) fail(file, c->source(), "calibrate", "expected tables [[calibrate]]");
+    if (!spec.has_reference) fail(file, c->source(), "calibrate", "a fitted calibration needs the study's [reference] to fit to");
+    for (const toml::node& n : *fits) {
+      const toml::table& t = *n.as_table();
+      allow_only(file, t, "calibrate.", {"scene", "model", "speed", "max_evaluations", "samples"});
+      StudyCalibrationFit fit;
+      const auto scene = t["scene"].value<std::string>();
+      bool known = false;
+      for (const std::filesystem::path& f : spec.scenes) known = known || (scene && f.stem() == *scene);
+      if (!known) fail(file, t["scene"].node() ? t["scene"].node()->source() : t.source(), "calibrate.scene", "expected a scene of study.scenes");
+      fit.scene = *scene;
+      const auto model = t["model"].value<std::string>();
+      if (!model || std::find(spec.models.begin(), spec.models.end(), *model) == spec.models.end())
+        fail(file, t["model"].node() ? t["model"].node()->source() : t.source(), "calibrate.model", "expected a model of study.models");
+      if (free_parameters(*model).empty())
+        fail(file, t["model"].node()->source(), "calibrate.model", "model \"" + *model + "\" has no free parameters to calibrate");
+      fit.model = *model;
+      if (auto v = t["speed"]) {
+        const auto f = v.value<double>();
+        if (!f || !(*f > 0.0) || *f == 1.0)
+          fail(file, v.node()->source(), "calibrate.speed", "expected a speed factor > 0 other than 1 (the scene's own trajectory is held out)");
+        fit.speed = *f;
+      }
+      if (auto v = t["max_evaluations"]) {
+        const auto e = v.value<int64_t>();
+        if (!e || *e < 1 || *e > 100000) fail(file, v.node()->source(), "calibrate.max_evaluations", "expected an integer in 1..100000");
+        fit.max_evaluations = static_cast<int>(*e);
+      }
+      if (auto v = t["samples"]) {
+        const auto n = v.value<int64_t>();
+        if (!n || *n < 2 || *n > 100000) fail(file, v.node()->source(), "calibrate.samples", "expected an integer in 2..100000");
+        fit.samples = static_cast<int>(*n);
+      }
+      const auto files = spec.calibrations.find(fit.scene);
+      if (files != spec.calibrations.end())
+        for (const std::filesystem::path& f : files->second) {
+          const auto models = calibrated_models(f);
+          if (std::find(models.begin(), models.end(), fit.model) != models.end())
+            fail(file, t.source(), "calibrate", "model " + fit.model + " on " + fit.scene + " is already calibrated by " + f.string() +
+                                                    " ([calibration]): one calibrated row per model and scene");
+        }
+      for (const StudyCalibrationFit& other : spec.fits)
+        if (other.scene == fit.scene && other.model == fit.model)
+          fail(file, t.source(), "calibrate", "model " + fit.model + " on " + fit.scene + " is fitted twice");
+      spec.fits.push_back(fit);
     }
   }
   return spec;

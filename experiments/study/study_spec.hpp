@@ -11,13 +11,30 @@
 //   degree = 1
 //   refinements = [0, 1]                           # mesh levels; the last is the finest
 //   samples = 40                                   # trajectory samples the reference solves
+//   linear_solver = "auto"                         # "auto", "direct" or "iterative"
+//   fracture = "off"                               # cohesive fracture: "off", "auto" or "on"
 //
 //   [calibration]                                  # optional: calibrated rows beside the others
 //   clay_pull = ["calibration/clay_pull.springs.toml"]   # parameter files (kerf calibrate -o),
 //                                                  # relative to the study file; every model a file
 //                                                  # calibrates also runs as "MODEL (calibrated)"
 //
+//   [[calibrate]]                                  # optional: a calibration fitted by the study
+//   scene = "clay_pull"                            # a scene of study.scenes
+//   model = "springs"                              # a model of study.models with free parameters
+//   speed = 2.0                                    # the calibration trajectory: the scene's played
+//                                                  # this many times as fast (!= 1): moves faster,
+//                                                  # holds shorter (study_runner.hpp)
+//   max_evaluations = 30                           # model runs of the fit (default 40)
+//   samples = 6                                    # reference solves on the calibration trajectory
+//                                                  # (default: [reference] samples)
+//   # fitted to the finest reference on the calibration trajectory, then run and scored, as
+//   # "MODEL (calibrated)", on the scene's own trajectory: held out from the fit.
+//
 // Unknown keys and wrong types are errors naming file:line:column, as for scenes.
+
+#include "experiments/run/reference_fracture.hpp"
+#include "reference/finite_strain_solver.hpp"
 
 #include <filesystem>
 #include <map>
@@ -27,10 +44,31 @@
 
 namespace kerf {
 
+/// The finite-element reference of a study ([reference]): its discretisation and solver settings.
+/// Every one of them is in the reference cache's key (reference_cache.hpp).
 struct StudyReferenceSpec {
-  int degree = 1;
-  std::vector<int> refinements{0};
+  int degree = 1;                   ///< FE_SimplexP degree, 1 or 2
+  std::vector<int> refinements{0};  ///< global mesh refinement levels, ascending; the last is the finest
   int samples = 40; ///< equilibrium solves along each trajectory (evenly spaced samples)
+  /// Linear solver of each Newton step (reference/finite_strain_solver.hpp): "auto" (direct below
+  /// 60 000 DOFs), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
+  reference::LinearSolverChoice linear_solver = reference::LinearSolverChoice::automatic;
+  /// Cohesive fracture along the scene's cut_plane (experiments/run/reference_fracture.hpp): "off"
+  /// (default, as `kerf reference`), "auto" or "on".
+  ReferenceFracture fracture = ReferenceFracture::off;
+};
+
+/// A calibration the study fits itself ([[calibrate]]): `model`'s free parameters
+/// (experiments/calibration/free_parameters.hpp) fitted to the finest reference level on the
+/// calibration trajectory — the scene's trajectory played `speed` times as fast (calibration_scene,
+/// study_runner.hpp) — and
+/// the fitted model scored on the scene's own trajectory, which the fit never saw.
+struct StudyCalibrationFit {
+  std::string scene;         ///< scene name (a study scene's file stem)
+  std::string model;         ///< catalogue name; fracture, springs or voxel
+  double speed = 2.0;        ///< the calibration trajectory is played this many times as fast (> 0, != 1)
+  int max_evaluations = 40;  ///< model runs per simplex search (>= 1)
+  int samples = 0;           ///< reference solves on the calibration trajectory; 0: the study's [reference] samples
 };
 
 struct StudySpec {
@@ -44,6 +82,8 @@ struct StudySpec {
   /// Parameter files per scene name ([calibration]): each model one of them calibrates is run a
   /// second time on the scene with the file included, as the row "MODEL (calibrated)".
   std::map<std::string, std::vector<std::filesystem::path>> calibrations;
+  /// Calibrations fitted by the study ([[calibrate]]); each adds the row "MODEL (calibrated)".
+  std::vector<StudyCalibrationFit> fits;
 };
 
 class StudyError : public std::runtime_error {

@@ -1,0 +1,141 @@
+#include "experiments/study/reference_cache.hpp"
+
+#include "experiments/profile/force_profile.hpp"
+#include "experiments/run/run_model.hpp"
+#include "reference/load_path.hpp"
+#include "reference/mpi_processes.hpp"
+
+#include <openssl/evp.h>
+
+#include <array>
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+
+namespace kerf {
+
+ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, int level,
+                                              const std::vector<std::size_t>& sample_indices) {
+  ReferenceRunSettings settings;
+  settings.degree = spec.degree;
+  settings.refinements = level;
+  settings.sample_indices = sample_indices;
+  settings.write_fields = false;
+  settings.linear_solver = spec.linear_solver;
+  settings.fracture = spec.fracture;
+  settings.distribute = false; // one process per solve: the study spreads whole solves over its ranks
+  return settings;
+}
+
+std::string text_sha256(const std::string& text) {
+  std::unique_ptr<EVP_MD_CTX, void (*)(EVP_MD_CTX*)> ctx(EVP_MD_CTX_new(), &EVP_MD_CTX_free);
+  if (!ctx || EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr) != 1 ||
+      EVP_DigestUpdate(ctx.get(), text.data(), text.size()) != 1)
+    throw std::runtime_error("SHA-256 unavailable");
+  std::array<unsigned char, EVP_MAX_MD_SIZE> digest{};
+  unsigned int length = 0;
+  EVP_DigestFinal_ex(ctx.get(), digest.data(), &length);
+  static constexpr char hex[] = "0123456789abcdef";
+  std::string out;
+  for (unsigned int i = 0; i < length; ++i) {
+    out += hex[digest[i] >> 4];
+    out += hex[digest[i] & 15];
+  }
+  return out;
+}
+
+namespace {
+
+/// A number written so that any change of its value changes the text (17 significant digits).
+std::string exact(double v) {
+  char s[40];
+  std::snprintf(s, sizeof s, "%.17g", v);
+  return s;
+}
+
+std::string material_line(const Material& m) {
+  return m.region + ": law " + (m.law == MaterialLaw::neo_hookean ? "neo-hookean" : "st-venant-kirchhoff") + ", E " +
+         exact(m.youngs_modulus) + ", nu " + exact(m.poisson_ratio) + ", rho " + exact(m.density) + ", J_c " +
+         exact(m.fracture_toughness) + ", sigma_c " + exact(m.cohesive_strength) + ", mu " + exact(m.friction_coefficient) +
+         ", eta " + exact(m.damping);
+}
+
+const char* solver_name(reference::LinearSolverChoice c) {
+  switch (c) {
+  case reference::LinearSolverChoice::automatic: return "automatic";
+  case reference::LinearSolverChoice::direct: return "direct";
+  case reference::LinearSolverChoice::iterative: return "iterative";
+  }
+  return "?";
+}
+
+const char* fracture_name(ReferenceFracture f) {
+  switch (f) {
+  case ReferenceFracture::automatic: return "automatic";
+  case ReferenceFracture::off: return "off";
+  case ReferenceFracture::on: return "on";
+  }
+  return "?";
+}
+
+} // namespace
+
+ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSettings& settings) {
+  // The scene: its file, the geometry file it meshes, and what a caller may have changed in
+  // memory since reading it (materials, mesh size, the trajectory).
+  const std::string scene_sha = file_sha256(scene.file);
+  std::string text = "scene_file_sha256 = " + scene_sha + "\n";
+  text += "geometry_file_sha256 = " + file_sha256(scene.geometry.source) + "\n";
+  std::string parameters;
+  for (const auto& [name, value] : scene.geometry.parameters) parameters += " " + name + "=" + exact(value);
+  text += "geometry_parameters =" + parameters + "\n";
+  text += "element_size = " + exact(scene.geometry.element_size) + "\n";
+  text += "material = " + material_line(scene.material) + "\n";
+  for (const Material& layer : scene.layers) text += "layer = " + material_line(layer) + "\n";
+
+  // The sampled trajectory at the solved samples (all of them when none are chosen): time and
+  // position of every tool.
+  const std::vector<SampledTrajectory> trajectories = sample_scene_trajectories(scene);
+  std::string motion;
+  std::size_t n = 0;
+  for (const SampledTrajectory& t : trajectories) n = std::max(n, t.samples.size());
+  std::vector<std::size_t> indices = settings.sample_indices;
+  if (indices.empty())
+    for (std::size_t k = 0; k < n; ++k) indices.push_back(k);
+  for (std::size_t t = 0; t < trajectories.size(); ++t)
+    for (std::size_t k : indices) {
+      const auto& samples = trajectories[t].samples;
+      const ToolState& s = samples[std::min(k, samples.size() - 1)];
+      motion += std::to_string(t) + " " + exact(s.time) + " " + exact(s.position.x()) + " " + exact(s.position.y()) + " " +
+                exact(s.position.z()) + "\n";
+    }
+  text += "trajectory_samples = " + std::to_string(indices.size()) + " of " + std::to_string(n) + "\n";
+  text += "trajectory_sha256 = " + text_sha256(motion) + "\n";
+
+  // The solver: what the settings choose, and the defaults run_reference keeps.
+  const reference::SolverSettings defaults;
+  text += "degree = " + std::to_string(settings.degree) + "\n";
+  text += "refinements = " + std::to_string(settings.refinements) + "\n";
+  text += "linear_solver = " + std::string(solver_name(settings.linear_solver)) + "\n";
+  text += "direct_dof_limit = " + std::to_string(defaults.direct_dof_limit) + "\n";
+  text += "iterative_tolerance = " + exact(defaults.iterative_tolerance) + "\n";
+  text += "newton_relative_tolerance = " + exact(defaults.relative_tolerance) + "\n";
+  text += "newton_absolute_tolerance = " + exact(defaults.absolute_tolerance) + "\n";
+  text += "max_newton_iterations = " + std::to_string(defaults.max_newton_iterations) + "\n";
+  text += "contact_penalty = " + (defaults.contact_penalty == 0.0 ? std::string("automatic") : exact(defaults.contact_penalty)) + "\n";
+  text += "max_cutbacks = " + std::to_string(reference::LoadPathSettings{}.max_cutbacks) + "\n";
+  text += "fracture = " + std::string(fracture_name(settings.fracture)) + "\n";
+  // Distributed over N processes the solve sums in another order (round-off) and the linear solver
+  // is MUMPS or a parallel GAMG: N is part of the key; not distributed, it is one process.
+  const int processes = settings.distribute ? std::max(1, reference::mpirun_process_count()) : 1;
+  text += "processes = " + std::to_string(processes) + "\n";
+
+  ReferenceCacheKey key;
+  key.text = text;
+  key.directory = scene_sha.substr(0, 16) + "-p" + std::to_string(settings.degree) + "-L" +
+                  std::to_string(settings.refinements) + "-n" + std::to_string(indices.size()) + "-" +
+                  text_sha256(text).substr(0, 16);
+  return key;
+}
+
+} // namespace kerf

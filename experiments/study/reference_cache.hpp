@@ -1,0 +1,49 @@
+#pragma once
+// The reference cache of a study (issue 7: "cached by the hash of the scene and solver settings,
+// so a re-run reuses it"). A reference solve is identified by every input that changes its
+// numbers: the scene (its file, the geometry it meshes, the materials, the sampled trajectory at
+// the solved samples — a trajectory scaled or replayed in memory is not in the file) and the
+// solver settings (FE degree, mesh level, linear solver and its tolerances, Newton tolerances,
+// contact penalty, load-path cut-backs, cohesive fracture on/off, the number of MPI processes the
+// mesh is distributed over). Any change of one of them misses the cache; nothing else does.
+//
+// Not in the key: the reference's source code. A change of the solver's code that changes its
+// numbers without changing a setting needs the cache deleted (docs/studies.md).
+
+#include "experiments/run/reference_run.hpp"
+#include "experiments/scene/scene.hpp"
+#include "experiments/study/study_spec.hpp"
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace kerf {
+
+/// The settings a study's reference solve at mesh level `level` runs with: `spec`'s degree,
+/// linear solver and fracture mode, the solved `sample_indices`, no field files, and the mesh not
+/// distributed (each solve is one process's run, whatever the study's MPI ranks: study_runner.hpp).
+ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, int level,
+                                              const std::vector<std::size_t>& sample_indices);
+
+/// A reference solve's identity in the cache.
+struct ReferenceCacheKey {
+  /// One "name = value" line per input that changes the reference's numbers (see file comment),
+  /// written beside the cached profile as `key.txt`.
+  std::string text;
+  /// The cache entry's directory name: `<scene sha256, 16 hex>-p<degree>-L<level>-n<samples>-<sha256
+  /// of text, 16 hex>` (readable prefix, exact suffix).
+  std::string directory;
+};
+
+/// The cache key of `scene` solved with `settings` (as study_reference_settings makes them, or
+/// `kerf calibrate`'s). The solver's own defaults that `run_reference` does not take from
+/// `settings` (reference::SolverSettings tolerances, DOF limit, penalty; LoadPathSettings
+/// cut-backs) enter with their current values, so a changed default also misses the cache.
+/// Throws std::runtime_error if the scene or geometry file cannot be read.
+ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSettings& settings);
+
+/// SHA-256 of `text`, 64 lowercase hex digits.
+std::string text_sha256(const std::string& text);
+
+} // namespace kerf

@@ -1,0 +1,113 @@
+// The reference cache key (experiments/study/reference_cache.hpp): every input that changes the
+// reference's numbers changes the key, and nothing else does.
+
+#include "experiments/study/reference_cache.hpp"
+
+#include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/stability_sweep.hpp"
+#include "experiments/study/study_runner.hpp"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <set>
+
+using namespace kerf;
+namespace fs = std::filesystem;
+
+namespace {
+
+Scene clay_pull() { return read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml"); }
+
+ReferenceRunSettings settings_of(const Scene& scene, const StudyReferenceSpec& spec, int level) {
+  std::size_t n = 0;
+  for (const auto& t : sample_scene_trajectories(scene)) n = std::max(n, t.samples.size());
+  return study_reference_settings(spec, level, reference_sample_indices(n, spec.samples));
+}
+
+} // namespace
+
+TEST(ReferenceCache, StudySettingsCarryTheSpecAndNeverDistribute) {
+  StudyReferenceSpec spec;
+  spec.degree = 2;
+  spec.linear_solver = reference::LinearSolverChoice::iterative;
+  spec.fracture = ReferenceFracture::automatic;
+  const ReferenceRunSettings s = study_reference_settings(spec, 3, {0, 5, 9});
+  EXPECT_EQ(s.degree, 2);
+  EXPECT_EQ(s.refinements, 3);
+  EXPECT_EQ(s.sample_indices, (std::vector<std::size_t>{0, 5, 9}));
+  EXPECT_EQ(s.linear_solver, reference::LinearSolverChoice::iterative);
+  EXPECT_EQ(s.fracture, ReferenceFracture::automatic);
+  EXPECT_FALSE(s.distribute); // one process per solve: the study spreads whole solves over ranks
+  EXPECT_FALSE(s.write_fields);
+}
+
+TEST(ReferenceCache, UnchangedInputsGiveTheSameKey) {
+  const Scene a = clay_pull(), b = clay_pull(); // read twice: nothing but the inputs may enter
+  StudyReferenceSpec spec;
+  spec.samples = 6;
+  const ReferenceCacheKey ka = reference_cache_key(a, settings_of(a, spec, 0));
+  const ReferenceCacheKey kb = reference_cache_key(b, settings_of(b, spec, 0));
+  EXPECT_EQ(ka.text, kb.text);
+  EXPECT_EQ(ka.directory, kb.directory);
+  // The readable prefix: scene hash, degree, level, samples; then the hash of the whole key.
+  EXPECT_EQ(ka.directory.substr(0, 16), file_sha256(a.file).substr(0, 16));
+  EXPECT_NE(ka.directory.find("-p1-L0-n6-"), std::string::npos) << ka.directory;
+  // Write-only settings (field files, checkpoints) do not change the reference's numbers.
+  ReferenceRunSettings s = settings_of(a, spec, 0);
+  s.write_fields = true;
+  s.checkpoint_every = 1;
+  EXPECT_EQ(reference_cache_key(a, s).directory, ka.directory);
+}
+
+TEST(ReferenceCache, EveryNumberChangingInputMissesTheCache) {
+  const Scene nominal = clay_pull();
+  StudyReferenceSpec spec;
+  spec.samples = 6;
+  const std::string base = reference_cache_key(nominal, settings_of(nominal, spec, 0)).directory;
+  // Each change below changes what the reference computes; each must give a key of its own.
+  const std::pair<std::string, std::function<ReferenceCacheKey()>> changes[] = {
+      {"degree", [&] { StudyReferenceSpec s = spec; s.degree = 2; return reference_cache_key(nominal, settings_of(nominal, s, 0)); }},
+      {"level", [&] { return reference_cache_key(nominal, settings_of(nominal, spec, 1)); }},
+      {"samples", [&] { StudyReferenceSpec s = spec; s.samples = 7; return reference_cache_key(nominal, settings_of(nominal, s, 0)); }},
+      {"linear solver", [&] {
+         StudyReferenceSpec s = spec;
+         s.linear_solver = reference::LinearSolverChoice::iterative;
+         return reference_cache_key(nominal, settings_of(nominal, s, 0));
+       }},
+      {"direct solver", [&] {
+         StudyReferenceSpec s = spec;
+         s.linear_solver = reference::LinearSolverChoice::direct;
+         return reference_cache_key(nominal, settings_of(nominal, s, 0));
+       }},
+      {"fracture", [&] {
+         StudyReferenceSpec s = spec;
+         s.fracture = ReferenceFracture::on;
+         return reference_cache_key(nominal, settings_of(nominal, s, 0));
+       }},
+      {"E in memory", [&] { const Scene s = scaled_scene(nominal, "stiffness", 2.0); return reference_cache_key(s, settings_of(s, spec, 0)); }},
+      {"nu in memory", [&] { const Scene s = scaled_scene(nominal, "poisson", 0.49); return reference_cache_key(s, settings_of(s, spec, 0)); }},
+      {"element size", [&] { const Scene s = scaled_scene(nominal, "element_size", 0.5); return reference_cache_key(s, settings_of(s, spec, 0)); }},
+      // A faster trajectory: the same file, the same sample count, other times and positions.
+      {"trajectory", [&] { const Scene s = scaled_scene(nominal, "speed", 2.0); return reference_cache_key(s, settings_of(s, spec, 0)); }},
+  };
+  std::set<std::string> keys{base};
+  for (const auto& [what, key] : changes) {
+    const ReferenceCacheKey k = key();
+    EXPECT_NE(k.directory, base) << what << " did not change the key:\n" << k.text;
+    keys.insert(k.directory);
+  }
+  EXPECT_EQ(keys.size(), std::size(changes) + 1); // and no two changes collide
+}
+
+TEST(ReferenceCache, TheKeyNamesTheSolverSettings) {
+  // key.txt is read by people deciding whether a cache entry is the one they want.
+  const Scene scene = clay_pull();
+  StudyReferenceSpec spec;
+  spec.linear_solver = reference::LinearSolverChoice::direct;
+  const std::string text = reference_cache_key(scene, settings_of(scene, spec, 1)).text;
+  for (const char* line : {"degree = 1\n", "refinements = 1\n", "linear_solver = direct\n", "fracture = off\n", "processes = 1\n",
+                           "newton_relative_tolerance = ", "iterative_tolerance = ", "contact_penalty = automatic\n",
+                           "max_cutbacks = ", "max_newton_iterations = ", "trajectory_sha256 = "})
+    EXPECT_NE(text.find(line), std::string::npos) << line << " not in\n" << text;
+}
