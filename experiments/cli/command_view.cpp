@@ -117,7 +117,7 @@ void write_trajectory_csv(const SampledTrajectory& t, const std::filesystem::pat
 
 /// `kerf view SCENE --model M --screenshot F [--at T]`: off line, deterministic.
 void scene_screenshot(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, BuiltModel& built) {
-  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(*built.model, mesh);
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(built, mesh);
   ViewedModel viewed(*built.model, *adapter, 1.0);
   ViewWindowSettings ws;
   ws.width = o.width;
@@ -202,7 +202,7 @@ void scene_live(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, B
   std::fflush(stdout);
   LiveViewReport report;
   try {
-    report = run_live_view(*built.model, mesh, raw, s, &viewed_loop);
+    report = run_live_view(*built.model, built.core_model(), mesh, raw, s, &viewed_loop);
   } catch (...) {
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);

@@ -70,7 +70,7 @@ LiveViewReport session(const std::string& scene_name, const std::string& model_n
     s.frame.tools.push_back({tool.kind == Tool::Kind::blade, tool.radius, tool.blade.edge_direction,
                              tool.blade.cutting_direction, tool.blade.edge_length});
   }
-  return run_live_view(*built.model, mesh, raw, s);
+  return run_live_view(*built.model, built.core_model(), mesh, raw, s);
 }
 
 /// The overrun counter with and without the view, in up to three attempts (a machine shared by

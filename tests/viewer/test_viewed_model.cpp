@@ -145,6 +145,23 @@ TEST(SpringsAdapter, TornBodyMovesWithItsPieces) {
   EXPECT_GT(right, 100);
 }
 
+// What `kerf view SCENE --model M` and the replay of a run get from the catalogue: each model is
+// read by its own adapter (the overlay it draws names it), also where a builder wraps the model
+// proper for `kerf run`'s recording (BuiltModel::core_model()); a model without an adapter would
+// show its body at rest, which for these four would hide what they do.
+TEST(ModelAdapter, EachCatalogueModelIsReadByItsOwnAdapter) {
+  const std::vector<std::array<std::string, 3>> cases{{"clay_pull", "springs", "spring network"},
+                                                      {"sponge_cut_constant", "voxel", "voxel grid"},
+                                                      {"potato_rect_cut", "fracture", "crack"},
+                                                      {"potato_rect_cut", "edge", "discrete edge"}};
+  for (const auto& [scene_name, model, overlay] : cases) {
+    const Scene scene = read_scene(std::string(KERF_SCENES_DIR) + "/" + scene_name + ".toml");
+    const TetMesh mesh = scene_mesh(scene);
+    const BuiltModel built = make_model(model, scene, mesh);
+    EXPECT_EQ(make_model_adapter(built, mesh)->overlay_name(), overlay) << scene_name << " / " << model;
+  }
+}
+
 // A .pvd written like the reference's (kerf's VTU writer, a displacement field, steps listed
 // out of order) reads back sorted, with points moved by exactly the displacement.
 TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {
