@@ -206,7 +206,7 @@ BodyView::BodyView(vtkRenderer* renderer, Colouring colouring, std::vector<ToolG
   m_bar->SetNumberOfLabels(3);
   m_bar->SetOrientationToHorizontal();
   m_bar->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-  m_bar->SetPosition(0.6, 0.02);
+  m_bar->SetPosition(0.55, 0.02); // room right of the bar for half of its last label
   m_bar->SetWidth(0.38);
   m_bar->SetHeight(0.1);
   m_bar->GetTitleTextProperty()->SetColor(0.0, 0.0, 0.0);

@@ -8,8 +8,9 @@
 
 namespace kerf {
 
-LiveViewReport run_live_view(ToolModel& model, const TetMesh& mesh, std::span<HapticDevice* const> devices,
-                             const LiveViewSettings& settings, std::atomic<ServoLoop*>* running) {
+LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const TetMesh& mesh,
+                             std::span<HapticDevice* const> devices, const LiveViewSettings& settings,
+                             std::atomic<ServoLoop*>* running) {
   if (!(settings.display_rate > 0.0 && settings.display_rate <= 240.0))
     throw std::invalid_argument("viewer: display rate must be in (0, 240] Hz, got " + std::to_string(settings.display_rate));
   LiveViewReport out;
@@ -21,7 +22,7 @@ LiveViewReport run_live_view(ToolModel& model, const TetMesh& mesh, std::span<Ha
     return out;
   }
 
-  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(model, mesh);
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(shown, mesh);
   ViewedModel viewed(model, *adapter, 1.0 / settings.display_rate);
   ViewWindowSettings window_settings = settings.window;
   window_settings.offscreen = !settings.interactive;

@@ -34,10 +34,12 @@ struct LiveViewReport {
 };
 
 /// Runs one session: `model` (built on `mesh`) driven by `devices` (one per tool), viewed when
-/// settings.view. `running`, when given, holds the loop while it runs (for a signal handler's
-/// emergency stop). In an interactive window: key o toggles the overlay, q (or closing the
-/// window) ends the session with a ramp out.
-LiveViewReport run_live_view(ToolModel& model, const TetMesh& mesh, std::span<HapticDevice* const> devices,
-                             const LiveViewSettings& settings, std::atomic<ServoLoop*>* running = nullptr);
+/// settings.view through the adapter of `shown` (make_model_adapter): `model` itself, or the
+/// model proper that `model` wraps (BuiltModel::core_model()). `running`, when given, holds the
+/// loop while it runs (for a signal handler's emergency stop). In an interactive window: key o
+/// toggles the overlay, q (or closing the window) ends the session with a ramp out.
+LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const TetMesh& mesh,
+                             std::span<HapticDevice* const> devices, const LiveViewSettings& settings,
+                             std::atomic<ServoLoop*>* running = nullptr);
 
 } // namespace kerf

@@ -45,4 +45,8 @@ std::unique_ptr<ModelAdapter> make_model_adapter(const ToolModel& model, const T
   return std::make_unique<RestBodyAdapter>(model, mesh);
 }
 
+std::unique_ptr<ModelAdapter> make_model_adapter(const BuiltModel& built, const TetMesh& mesh) {
+  return make_model_adapter(built.core_model(), mesh);
+}
+
 } // namespace kerf

@@ -7,6 +7,7 @@
 //              reserved ModelState (allocation-free, lock-free, bounded: the servo's rules);
 //   geometry — in the render thread, turns a captured ViewFrame into BodyGeometry (allocates).
 
+#include "experiments/run/model_catalogue.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "realtime/tool_model.hpp"
 #include "viewer/body_geometry.hpp"
@@ -36,5 +37,10 @@ public:
 /// built on `mesh`, the scene mesh the model was built from. A model type without an adapter
 /// gets the rest mesh and no overlay (the tools, forces and text are drawn for every model).
 std::unique_ptr<ModelAdapter> make_model_adapter(const ToolModel& model, const TetMesh& mesh);
+
+/// The adapter for a model from the catalogue (make_model): it reads the model proper,
+/// `built.core_model()`, which a builder may wrap for `kerf run`'s own recording (the springs
+/// run's .vtu series); the wrapper is what is stepped, the model proper what is read.
+std::unique_ptr<ModelAdapter> make_model_adapter(const BuiltModel& built, const TetMesh& mesh);
 
 } // namespace kerf

@@ -163,7 +163,7 @@ RecordedRun::RecordedRun(const std::filesystem::path& dir, int frames) {
   if (m_model_name == "springs" && parameters.contains("integrator"))
     options["integrator"] = parameters["integrator"].get<std::string>();
   BuiltModel built = make_model(m_model_name, *m_scene, mesh, options);
-  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(*built.model, mesh);
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(built, mesh);
   ViewedModel viewed(*built.model, *adapter, 1.0);
   // The scene's own trajectories when the profile recorded exactly those positions (a plain
   // `kerf run`: the same samples, velocities included), else the recorded positions.

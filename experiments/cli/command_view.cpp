@@ -48,6 +48,7 @@ struct ViewOptions {
   bool no_text = false;
   bool no_chart = false;
   bool offscreen = false;
+  bool no_view = false;
   int width = 1280;
   int height = 800;
   double display_rate = 60.0;
@@ -117,7 +118,7 @@ void write_trajectory_csv(const SampledTrajectory& t, const std::filesystem::pat
 
 /// `kerf view SCENE --model M --screenshot F [--at T]`: off line, deterministic.
 void scene_screenshot(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, BuiltModel& built) {
-  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(*built.model, mesh);
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(built, mesh);
   ViewedModel viewed(*built.model, *adapter, 1.0);
   ViewWindowSettings ws;
   ws.width = o.width;
@@ -181,6 +182,7 @@ void scene_live(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, B
     else if (r.fifo && r.locked) std::fprintf(stderr, "kerf view: servo thread SCHED_FIFO, memory locked\n");
     else std::fputs(r.warnings.c_str(), stderr);
   };
+  s.view = !o.no_view;
   s.interactive = !o.offscreen;
   s.display_rate = o.display_rate;
   s.window.width = o.width;
@@ -202,7 +204,7 @@ void scene_live(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, B
   std::fflush(stdout);
   LiveViewReport report;
   try {
-    report = run_live_view(*built.model, mesh, raw, s, &viewed_loop);
+    report = run_live_view(*built.model, built.core_model(), mesh, raw, s, &viewed_loop);
   } catch (...) {
     sigaction(SIGINT, &old_int, nullptr);
     sigaction(SIGTERM, &old_term, nullptr);
@@ -221,10 +223,12 @@ void scene_live(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, B
               report.servo.realtime.fifo ? " (SCHED_FIFO)" : "");
   std::printf("  whole tick     p50 %8.2f us  p99 %8.2f us  max %8.2f us\n", t.tick.percentile(50) * 1e6,
               t.tick.percentile(99) * 1e6, t.tick.max() * 1e6);
-  std::printf("view: %llu snapshots (longest %.2f us in the servo thread), %llu frames drawn (mean %.2f ms, max %.2f ms)\n",
-              static_cast<unsigned long long>(report.frames_published), report.max_capture_seconds * 1e6,
-              static_cast<unsigned long long>(report.frames_rendered), report.mean_render_seconds * 1e3,
-              report.max_render_seconds * 1e3);
+  if (o.no_view) std::printf("view: off (--no-view)\n");
+  else
+    std::printf("view: %llu snapshots (longest %.2f us in the %s thread), %llu frames drawn (mean %.2f ms, max %.2f ms)\n",
+                static_cast<unsigned long long>(report.frames_published), report.max_capture_seconds * 1e6,
+                o.model_rate > 0.0 ? "model" : "servo", static_cast<unsigned long long>(report.frames_rendered),
+                report.mean_render_seconds * 1e3, report.max_render_seconds * 1e3);
   if (!o.screenshot.empty()) std::printf("wrote %s\n", o.screenshot.c_str());
 }
 
@@ -238,6 +242,7 @@ void run_scene_view(const ViewOptions& o) {
   ModelOptions options;
   if (!o.integrator.empty()) options["integrator"] = o.integrator;
   BuiltModel built = make_model(o.model, scene, mesh, options);
+  if (o.no_view && !o.screenshot.empty()) throw std::invalid_argument("view: --no-view takes no --screenshot");
   if (!o.screenshot.empty() && o.devices.empty() && !o.offscreen) scene_screenshot(o, scene, mesh, built);
   else scene_live(o, scene, mesh, built);
 }
@@ -303,6 +308,8 @@ void add_view_command(CLI::App& app) {
   c->add_flag("--no-text", o->no_text, "no text or colour legend in the picture");
   c->add_flag("--no-chart", o->no_chart, "runs: no force-displacement chart below the views");
   c->add_flag("--offscreen", o->offscreen, "live session rendered off screen at display rate (no window)");
+  c->add_flag("--no-view", o->no_view,
+              "live: the same session without the view (no window, no snapshots), to compare the servo statistics");
   c->add_option("--width", o->width, "window width [px]")->capture_default_str();
   c->add_option("--height", o->height, "window height [px]")->capture_default_str();
   c->add_option("--display-rate", o->display_rate, "frames per second of the live view [Hz]")->capture_default_str();

@@ -21,8 +21,19 @@ using namespace kerf;
 
 namespace {
 
+std::filesystem::path scratch_dir() {
+  return std::filesystem::temp_directory_path() / ("kerf_test_live_view_" + std::to_string(::getpid()));
+}
+
+/// Removes the replay devices' trajectory files at the end.
+class ScratchCleanup : public ::testing::Environment {
+public:
+  void TearDown() override { std::filesystem::remove_all(scratch_dir()); }
+};
+[[maybe_unused]] const ::testing::Environment* const cleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
+
 std::filesystem::path trajectory_csv(const SampledTrajectory& t, const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_live_view_" + std::to_string(::getpid()));
+  const auto dir = scratch_dir();
   std::filesystem::create_directories(dir);
   const auto file = dir / (name + ".csv");
   std::ofstream out(file);
@@ -59,7 +70,7 @@ LiveViewReport session(const std::string& scene_name, const std::string& model_n
     s.frame.tools.push_back({tool.kind == Tool::Kind::blade, tool.radius, tool.blade.edge_direction,
                              tool.blade.cutting_direction, tool.blade.edge_length});
   }
-  return run_live_view(*built.model, mesh, raw, s);
+  return run_live_view(*built.model, built.core_model(), mesh, raw, s);
 }
 
 /// The overrun counter with and without the view, in up to three attempts (a machine shared by

@@ -23,11 +23,23 @@ using kerf::test::PngImage;
 
 namespace {
 
-std::filesystem::path scratch(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_viewer_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  return dir / name;
+std::filesystem::path scratch_dir() {
+  return std::filesystem::temp_directory_path() / ("kerf_test_viewer_" + std::to_string(::getpid()));
 }
+
+std::filesystem::path scratch(const std::string& name) {
+  std::filesystem::create_directories(scratch_dir());
+  return scratch_dir() / name;
+}
+
+/// Removes the runs and pictures when every test passed (kept for a look when one failed).
+class ScratchCleanup : public ::testing::Environment {
+public:
+  void TearDown() override {
+    if (::testing::UnitTest::GetInstance()->Passed()) std::filesystem::remove_all(scratch_dir());
+  }
+};
+[[maybe_unused]] const ::testing::Environment* const cleanup = ::testing::AddGlobalTestEnvironment(new ScratchCleanup);
 
 /// Runs kerf with `arguments`; returns its exit code and standard output.
 std::pair<int, std::string> run_kerf(const std::string& arguments) {
@@ -134,21 +146,26 @@ TEST(ViewerScreenshot, ClayPullChangesOnlyWhereTheBodyDeforms) {
 }
 
 // clay_tear (experiments/scenes/clay_tear.toml): a 60 x 20 x 20 mm block pulled apart at x = 15
-// and 45 mm by 10 mm each; the network (8 cells of 7.5 mm) tears where the tensile stress passes
-// the cohesive strength, the expected tear surface being the mid-plane x = 30 mm. Fragments along
-// the pulling direction: the picture's columns that hold foreground within the block's height
-// (z in [1, 19] mm), in runs. At rest one run; torn and pulled apart two, separated by a gap of
-// empty columns that lies on the tear line to within one network cell (7.5 mm).
+// and 45 mm by 10 mm each; the network (cells of h = 5 mm, [models.springs]) tears where the
+// tensile stress passes the cohesive strength, along cell faces (vertex splitting), the expected
+// tear surface being the mid-plane x = 30 mm. Fragments along the pulling direction: the
+// picture's columns that hold foreground within the block's height (z in [1, 19] mm), in runs. At
+// rest one run; torn and pulled apart two, separated by a gap of empty columns centred within
+// 1.5 cells (7.5 mm) of the mid-plane (this model tears at the face x = 35 mm: the gap's centre
+// in the rest frame is the tear's position). The gap is as wide as the pieces moved apart: each
+// follows its stylus, 10 mm out (the scene's trajectories), 20 mm in all for a plane tear, down
+// to 15 mm if the tear steps by one cell across the section.
 TEST(ViewerScreenshot, TornClayShowsTwoFragmentsAlongTheTearLine) {
   const auto run = scratch("clay_tear_springs");
   auto [code, out] = run_kerf("run clay_tear --model springs -o " + run.string());
   ASSERT_EQ(code, 0) << out;
   {
-    // The model marks the sample at which a tear separates the network "rupture" (springs model);
-    // without a tear there are no fragments to see.
+    // The model marks the sample at which a tear separates the network "rupture" (springs model;
+    // tests/realtime/springs/test_tearing.cpp: clay_tear tears). Without a tear there would be
+    // no fragments to see, and the pictures below would test nothing.
     std::ifstream profile(run / "profile.csv");
     const std::string text((std::istreambuf_iterator<char>(profile)), std::istreambuf_iterator<char>());
-    if (text.find(",rupture,") == std::string::npos) GTEST_SKIP() << "the springs model did not tear clay_tear";
+    ASSERT_NE(text.find(",rupture,"), std::string::npos) << "the springs model did not tear clay_tear";
   }
   const auto before = scratch("clay_tear_0.png"), after = scratch("clay_tear_end.png");
   const std::string common = "view " + run.string() + picture;
@@ -179,6 +196,9 @@ TEST(ViewerScreenshot, TornClayShowsTwoFragmentsAlongTheTearLine) {
   ASSERT_EQ(fragments(b, &runs), 2) << "the torn block should show two fragments";
   const double gap_centre = f.x((runs[0].second + runs[1].first) / 2);
   EXPECT_NEAR(gap_centre, 0.030, 0.0075) << "the gap should lie on the tear line x = 30 mm";
+  const double gap_width = (runs[1].first - runs[0].second - 1) / f.pixels_per_metre;
+  EXPECT_GT(gap_width, 0.015) << "the pieces should be 20 mm apart";
+  EXPECT_LT(gap_width, 0.0205) << "the pieces should be 20 mm apart";
 }
 
 // kerf view RUN RUN: the same run side by side must give the same picture in both halves (one

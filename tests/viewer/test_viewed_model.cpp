@@ -97,6 +97,71 @@ TEST(SpringsAdapter, FineMeshFollowsTheNetworkInsideAndRestsOutside) {
   EXPECT_LT(largest, 8e-3 + 1e-4);
 }
 
+// Paper 000 §2.2 (Fig. 5): once the network tears, the fine mesh is divided along the exposed cell
+// faces and each side follows the cells of its own piece. clay_tear
+// (experiments/scenes/clay_tear.toml: its gmsh mesh, whose unstructured tetrahedra cross the
+// network's cell faces, and the network settings of tests/realtime/springs/test_tearing.cpp,
+// the scene's own): the styluses pull the 60 mm bar apart by 10 mm each
+// (2 s), then hold (1 s); the bar tears near its mid-plane x = 30 mm and each piece, free on its
+// table, follows its stylus: a translation by 10 mm along -x (left) or +x (right). So every fine
+// node drawn at t = 3 s, the tear's neighbourhood included, has moved about 10 mm; the tear runs
+// along cell faces (vertex splitting, h = 5 mm) within a cell of the mid-plane, so nodes left of
+// x = 25 mm moved along -x and nodes right of x = 35 mm along +x; none is left behind at rest.
+TEST(SpringsAdapter, TornBodyMovesWithItsPieces) {
+  const Scene scene = read_scene(std::string(KERF_SCENES_DIR) + "/clay_tear.toml");
+  const TetMesh mesh = scene_mesh(scene);
+  SpringNetworkSetup s = test::clay_pull_setup(SpringIntegrator::implicit_euler);
+  s.supports = {{"support", true}};
+  s.styluses = {{Eigen::Vector3d(0.015, 0.0, 0.022), 0.002}, {Eigen::Vector3d(0.045, 0.0, 0.022), 0.002}};
+  s.cells = 12;
+  s.cell_size = 0.005;
+  s.grasp_radius = 0.0075;
+  s.tearing = true;
+  s.tensile_limit = 50e3;
+  SpringNetworkModel model(mesh, s);
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(model, mesh);
+  ViewedModel viewed(model, *adapter, 1.0);
+  const std::array<double, 1> times{3.0};
+  BodyGeometry g;
+  step_through(viewed, sample_scene_trajectories(scene), times,
+               [&](const ViewFrame& f) { adapter->geometry(f, g); });
+  ASSERT_EQ(model.pieces(), 2) << "clay_tear did not tear (" << model.tears() << " vertex splits)";
+  ASSERT_GT(g.rest.rows(), mesh.nodes.rows()) << "the drawn body should be the split mesh (nodes duplicated)";
+  int left = 0, right = 0, behind = 0;
+  for (Eigen::Index i = 0; i < g.rest.rows(); ++i) {
+    const Eigen::Vector3d u = (g.points.row(i) - g.rest.row(i)).transpose();
+    if (u.norm() < 5e-3) ++behind;
+    EXPECT_NEAR(u.norm(), 0.010, 1e-3) << "fine node " << i << " at x = " << g.rest(i, 0);
+    if (g.rest(i, 0) < 0.025 - 1e-6) {
+      ++left;
+      EXPECT_LT(u.x(), -0.009) << "fine node " << i;
+    } else if (g.rest(i, 0) > 0.035 + 1e-6) {
+      ++right;
+      EXPECT_GT(u.x(), 0.009) << "fine node " << i;
+    }
+  }
+  EXPECT_EQ(behind, 0) << "fine nodes left at rest behind their piece";
+  EXPECT_GT(left, 100);
+  EXPECT_GT(right, 100);
+}
+
+// What `kerf view SCENE --model M` and the replay of a run get from the catalogue: each model is
+// read by its own adapter (the overlay it draws names it), also where a builder wraps the model
+// proper for `kerf run`'s recording (BuiltModel::core_model()); a model without an adapter would
+// show its body at rest, which for these four would hide what they do.
+TEST(ModelAdapter, EachCatalogueModelIsReadByItsOwnAdapter) {
+  const std::vector<std::array<std::string, 3>> cases{{"clay_pull", "springs", "spring network"},
+                                                      {"sponge_cut_constant", "voxel", "voxel grid"},
+                                                      {"potato_rect_cut", "fracture", "crack"},
+                                                      {"potato_rect_cut", "edge", "discrete edge"}};
+  for (const auto& [scene_name, model, overlay] : cases) {
+    const Scene scene = read_scene(std::string(KERF_SCENES_DIR) + "/" + scene_name + ".toml");
+    const TetMesh mesh = scene_mesh(scene);
+    const BuiltModel built = make_model(model, scene, mesh);
+    EXPECT_EQ(make_model_adapter(built, mesh)->overlay_name(), overlay) << scene_name << " / " << model;
+  }
+}
+
 // A .pvd written like the reference's (kerf's VTU writer, a displacement field, steps listed
 // out of order) reads back sorted, with points moved by exactly the displacement.
 TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {

@@ -40,11 +40,14 @@ public:
     ASSERT_GE(m_pid, 0) << std::strerror(errno);
     if (m_pid == 0) {
       // Child: the pipe's write end becomes fd 3 for -displayfd; Xvfb's chatter goes to /dev/null.
+      // -noreset: an X server resets when its last client disconnects, and a kerf process that
+      // connects during the reset fails ("bad X server connection"); the tests run one kerf
+      // process after another, so the server must stay up between them.
       ::dup2(fds[1], 3);
       const int null = ::open("/dev/null", O_WRONLY);
       ::dup2(null, 1);
       ::dup2(null, 2);
-      ::execlp("Xvfb", "Xvfb", "-displayfd", "3", "-screen", "0", "1600x1200x24", "-nolisten", "tcp",
+      ::execlp("Xvfb", "Xvfb", "-displayfd", "3", "-screen", "0", "1600x1200x24", "-nolisten", "tcp", "-noreset",
                static_cast<char*>(nullptr));
       ::_exit(127);
     }
