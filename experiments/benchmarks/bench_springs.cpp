@@ -3,6 +3,7 @@
 // Run: build/experiments/benchmarks/bench_springs --benchmark_min_time=0.2
 
 #include "meshes/box_tet_mesh.hpp"
+#include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/network_embedding.hpp"
 #include "realtime/springs/spring_network_model.hpp"
 
@@ -45,6 +46,27 @@ void step_cost(benchmark::State& state, SpringIntegrator integrator) {
   state.counters["factorisations_per_step"] = static_cast<double>(model.factorisations()) / static_cast<double>(std::max(k, 1L));
 }
 
+/// One evaluation of the network's internal forces on a full N^3 block (clay, damped, every node
+/// displaced): the per-spring loop over the merged flat arrays (network_forces) against the
+/// vectorised lattice loops (LatticeForces) that both integrators use while the network is untorn.
+void force_cost(benchmark::State& state, bool lattice) {
+  const int n = static_cast<int>(state.range(0));
+  const double h = 2.5e-3;
+  NetworkBlock block;
+  block.cell_size = h;
+  block.cells = Eigen::Vector3i::Constant(n);
+  const SpringNetwork net = build_spring_network(block, std::vector<bool>(static_cast<std::size_t>(n * n * n), true),
+                                                 identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0, 2e-5);
+  Eigen::Matrix3Xd x = net.rest, v = Eigen::Matrix3Xd::Zero(3, net.node_capacity()), f(3, net.node_capacity());
+  for (int q = 0; q < net.node_count; ++q) x(2, q) += 1e-4 * std::sin(x(0, q) * 400.0), v(1, q) = 1e-3 * std::cos(x(2, q) * 300.0);
+  LatticeForces forces(net);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(lattice ? forces.evaluate(net, x, v, f) : network_forces(net, x, v, f));
+    benchmark::DoNotOptimize(f.data());
+  }
+  state.counters["springs"] = net.springs.count;
+}
+
 void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
   const int n = 8;
   const double h = 2.5e-3;
@@ -73,6 +95,8 @@ void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
 BENCHMARK_CAPTURE(step_cost, explicit, SpringIntegrator::symplectic_euler)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit, SpringIntegrator::implicit_euler)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, static, SpringIntegrator::quasi_static)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(force_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(embedding_cost, trilinear, EmbeddingScheme::trilinear)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, coons, EmbeddingScheme::coons)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 

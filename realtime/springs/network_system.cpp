@@ -1,5 +1,7 @@
 #include "realtime/springs/network_system.hpp"
 
+#include "realtime/springs/vector_clones.hpp"
+
 #include <cholmod.h>
 #include <dlfcn.h>
 
@@ -112,7 +114,7 @@ private:
 
 } // namespace
 
-NetworkSystem::NetworkSystem() {
+NetworkSystem::NetworkSystem(SolvePrecision precision) : m_precision(precision) {
   install_lease_hooks();
   m_common = new cholmod_common;
   cholmod_start(m_common);
@@ -120,7 +122,7 @@ NetworkSystem::NetworkSystem() {
   m_common->print = 0;
 }
 
-NetworkSystem::NetworkSystem(const SpringNetwork& net) : NetworkSystem() { rebuild(net); }
+NetworkSystem::NetworkSystem(const SpringNetwork& net, SolvePrecision precision) : NetworkSystem(precision) { rebuild(net); }
 
 NetworkSystem::~NetworkSystem() {
   release();
@@ -130,8 +132,6 @@ NetworkSystem::~NetworkSystem() {
 
 void NetworkSystem::release() noexcept {
   if (m_factor) cholmod_free_factor(&m_factor, m_common);
-  for (cholmod_dense** d : {&m_rhs, &m_solution, &m_work_y, &m_work_e})
-    if (*d) cholmod_free_dense(d, m_common);
 }
 
 double NetworkSystem::factor_entries() const {
@@ -167,7 +167,6 @@ void NetworkSystem::rebuild(const SpringNetwork& net) {
     return m;
   };
   m_matrix = lower_pattern(natural);
-  m_rhs = cholmod_allocate_dense(static_cast<std::size_t>(n), 1, static_cast<std::size_t>(n), CHOLMOD_REAL, m_common);
   if (n == 0) {
     m_dof_of.assign(natural.size(), -1);
     m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
@@ -228,11 +227,16 @@ void NetworkSystem::rebuild(const SpringNetwork& net) {
   // The lease for cholmod_super_numeric's temporary: its cholmod_dense header and L->maxcsize
   // entries, with room for alignment.
   m_update_buffer.assign(m_factor->maxcsize + (sizeof(cholmod_dense) + 256) / sizeof(double) + 1, 0.0);
-  // One factorisation and solve of the mass matrix sizes the solve's kept workspaces.
+  // The solve's workspaces: the single-precision factor, the rows below the tallest supernode.
+  if (!m_factor->is_super) throw std::runtime_error("NetworkSystem: CHOLMOD did not choose a supernodal factor");
+  m_factor_single.assign(m_precision == SolvePrecision::single_precision ? m_factor->xsize : 0, 0.0f);
+  const int* pi = static_cast<const int*>(m_factor->pi);
+  std::size_t tallest = 1;
+  for (std::size_t sn = 0; sn < m_factor->nsuper; ++sn) tallest = std::max(tallest, static_cast<std::size_t>(pi[sn + 1] - pi[sn]));
+  m_below.assign(tallest, 0.0);
+  // One factorisation of the mass matrix: CHOLMOD sizes what it keeps in Common now.
   assemble(net, net.rest, 1.0, 0.0);
   if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
-  Eigen::VectorXd ones = Eigen::VectorXd::Ones(n), out(n);
-  solve(ones, out);
   m_factorized = false;
 }
 
@@ -283,21 +287,90 @@ bool NetworkSystem::factorize() noexcept {
   }
   if (blas_threads > 1) g_blas_set_threads(blas_threads);
   m_factorized = m_common->status == CHOLMOD_OK && lease.live == 0;
+  if (m_factorized && !m_factor_single.empty()) {
+    const double* lx = static_cast<const double*>(m_factor->x);
+    for (std::size_t k = 0; k < m_factor_single.size(); ++k) m_factor_single[k] = static_cast<float>(lx[k]);
+  }
   return m_factorized;
 }
+
+namespace {
+
+/// L y = b then Lᵀ x = y in place on x, on a supernodal L whose values are `lx` (double or a
+/// single-precision copy; accumulation in double). Supernode s has columns [k1, k2) and a dense
+/// column-major block of nsrow rows (row indices ls[psi ..]): the first nscol rows are its
+/// diagonal triangle, the rest the rows below it. `below` has room for the tallest supernode.
+template <class Value>
+[[gnu::always_inline]] inline void supernodal_solve(const cholmod_factor& L, const Value* lx, double* x, double* below) noexcept {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* px = static_cast<const int*>(L.px);
+  const int* ls = static_cast<const int*>(L.s);
+  const auto nsuper = static_cast<int>(L.nsuper);
+  // Forward: L y = b.
+  for (int s = 0; s < nsuper; ++s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], nsrow = pi[s + 1] - psi;
+    const Value* block = lx + px[s];
+    for (int j = 0; j < nscol; ++j) {
+      const Value* col = block + static_cast<std::ptrdiff_t>(j) * nsrow;
+      const double xj = x[k1 + j] /= static_cast<double>(col[j]);
+#pragma omp simd
+      for (int i = j + 1; i < nscol; ++i) x[k1 + i] -= static_cast<double>(col[i]) * xj;
+    }
+    const int m = nsrow - nscol;
+    if (m == 0) continue;
+    std::fill(below, below + m, 0.0);
+    for (int j = 0; j < nscol; ++j) {
+      const Value* col = block + static_cast<std::ptrdiff_t>(j) * nsrow + nscol;
+      const double xj = x[k1 + j];
+#pragma omp simd
+      for (int i = 0; i < m; ++i) below[i] += static_cast<double>(col[i]) * xj;
+    }
+    for (int i = 0; i < m; ++i) x[ls[psi + nscol + i]] -= below[i];
+  }
+  // Backward: Lᵀ x = y.
+  for (int s = nsuper - 1; s >= 0; --s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], nsrow = pi[s + 1] - psi;
+    const Value* block = lx + px[s];
+    const int m = nsrow - nscol;
+    for (int i = 0; i < m; ++i) below[i] = x[ls[psi + nscol + i]];
+    for (int j = 0; j < nscol; ++j) {
+      const Value* col = block + static_cast<std::ptrdiff_t>(j) * nsrow + nscol;
+      double dot = 0.0;
+#pragma omp simd reduction(+ : dot)
+      for (int i = 0; i < m; ++i) dot += static_cast<double>(col[i]) * below[i];
+      x[k1 + j] -= dot;
+    }
+    for (int j = nscol - 1; j >= 0; --j) {
+      const Value* col = block + static_cast<std::ptrdiff_t>(j) * nsrow;
+      double dot = 0.0;
+#pragma omp simd reduction(+ : dot)
+      for (int i = j + 1; i < nscol; ++i) dot += static_cast<double>(col[i]) * x[k1 + i];
+      x[k1 + j] = (x[k1 + j] - dot) / static_cast<double>(col[j]);
+    }
+  }
+}
+
+KERF_VECTOR_CLONES
+void supernodal_solve_double(const cholmod_factor& L, const double* lx, double* x, double* below) noexcept {
+  supernodal_solve(L, lx, x, below);
+}
+KERF_VECTOR_CLONES
+void supernodal_solve_single(const cholmod_factor& L, const float* lx, double* x, double* below) noexcept {
+  supernodal_solve(L, lx, x, below);
+}
+
+} // namespace
 
 void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept {
   const int n = dof_count();
   if (n == 0) return;
-  double* b = static_cast<double*>(m_rhs->x);
-  std::copy(rhs.data(), rhs.data() + n, b);
-  // L Lᵀ out = rhs: the system is in the factor's order already, so no permutation (CHOLMOD_LDLt).
-  const int blas_threads = g_blas_get_threads ? g_blas_get_threads() : 1;
-  if (blas_threads > 1) g_blas_set_threads(1);
-  cholmod_solve2(CHOLMOD_LDLt, m_factor, m_rhs, nullptr, &m_solution, nullptr, &m_work_y, &m_work_e, m_common);
-  if (blas_threads > 1) g_blas_set_threads(blas_threads);
-  const double* x = static_cast<const double*>(m_solution->x);
-  std::copy(x, x + n, out.data());
+  // The system is in the factor's order already: no permutation.
+  std::copy(rhs.data(), rhs.data() + n, out.data());
+  if (m_factor_single.empty())
+    supernodal_solve_double(*m_factor, static_cast<const double*>(m_factor->x), out.data(), m_below.data());
+  else
+    supernodal_solve_single(*m_factor, m_factor_single.data(), out.data(), m_below.data());
 }
 
 } // namespace kerf

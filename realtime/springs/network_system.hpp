@@ -16,7 +16,6 @@
 
 struct cholmod_common_struct;
 struct cholmod_factor_struct;
-struct cholmod_dense_struct;
 
 namespace kerf {
 
@@ -25,9 +24,14 @@ public:
   /// Lower triangle stored, rows and columns in the factor's (fill-reducing) order.
   using Matrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-  NetworkSystem();
+  /// What the triangular solves read: CHOLMOD's factor itself, or a single-precision copy of it
+  /// (half the memory traffic, which bounds the solve; for a factor used as the approximate
+  /// Jacobian of modified Newton, whose residual is evaluated in double precision).
+  enum class SolvePrecision { double_precision, single_precision };
+
+  explicit NetworkSystem(SolvePrecision precision = SolvePrecision::double_precision);
   /// Builds the pattern for `net` (see `rebuild`).
-  explicit NetworkSystem(const SpringNetwork& net);
+  explicit NetworkSystem(const SpringNetwork& net, SolvePrecision precision = SolvePrecision::double_precision);
   ~NetworkSystem();
   NetworkSystem(const NetworkSystem&) = delete;
   NetworkSystem& operator=(const NetworkSystem&) = delete;
@@ -51,8 +55,11 @@ public:
   /// the supernode update block, comes from a buffer this object keeps). False if A is not
   /// positive definite.
   bool factorize() noexcept;
-  /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized).
-  /// cholmod_solve2 with the solution and workspaces kept between calls.
+  /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized):
+  /// L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's supernodal L (dense
+  /// column-major blocks): per supernode the diagonal triangle, then the rows below it as one
+  /// dense product, in loops the compiler vectorises, with no BLAS call per supernode (most
+  /// supernodes of a network are small, where the call overhead dominated cholmod_solve2).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept;
 
   /// The assembled matrix (lower triangle stored).
@@ -71,10 +78,9 @@ private:
   std::vector<int> m_diagonal; ///< value index of each dof's diagonal
   cholmod_common_struct* m_common = nullptr;
   cholmod_factor_struct* m_factor = nullptr;
-  cholmod_dense_struct* m_rhs = nullptr;
-  cholmod_dense_struct* m_solution = nullptr;
-  cholmod_dense_struct* m_work_y = nullptr;
-  cholmod_dense_struct* m_work_e = nullptr;
+  SolvePrecision m_precision;
+  std::vector<float> m_factor_single;  ///< single-precision copy of L's values (single_precision)
+  std::vector<double> m_below;         ///< solve workspace: the rows below one supernode
   std::vector<double> m_update_buffer; ///< CHOLMOD's supernode update workspace (see factorize)
   bool m_factorized = false;
 };

@@ -4,6 +4,7 @@
 // kept while it still converges (modified Newton) and refreshed when it does not, with a
 // backtracking line search on the residual so that a step far from the solution never diverges.
 
+#include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/network_system.hpp"
 #include "realtime/springs/spring_network.hpp"
 
@@ -42,6 +43,11 @@ public:
   /// 1/32 of the Newton step) lowers the residual. Allocation-free.
   NewtonReport advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
 
+  /// The internal forces at the state the last `advance` returned (at its velocities, or at
+  /// zero velocity quasi-statically) [N], 3 x capacity: the residual's own evaluation, so the
+  /// caller need not recompute them.
+  [[nodiscard]] const Eigen::Matrix3Xd& forces() const { return m_f; }
+
 private:
   bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
   double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
@@ -49,6 +55,7 @@ private:
   Mode m_mode;
   int m_max_iterations;
   NetworkSystem m_system;
+  LatticeForces m_forces;
   double m_tolerance_ratio;
   double m_factor_dt = -1.0;
   double m_static_regularisation = 0.0;

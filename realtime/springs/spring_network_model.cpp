@@ -32,8 +32,12 @@ namespace {
 
 /// Safety factor on the computed explicit limit (the limit is for the linearised network).
 constexpr double explicit_safety = 0.9;
-/// Relative Newton tolerance of the implicit and quasi-static integrators (NewtonStepper).
-constexpr double newton_tolerance = 1e-7;
+/// Relative Newton tolerance of the implicit and quasi-static integrators (NewtonStepper): the
+/// residual's max-norm <= 10⁻⁵ k₁ h, the force of an edge spring stretched by 10⁻⁵ of its length
+/// (4·10⁻⁶ N on the clay scenes' 2.5 mm cells, against stylus forces of 0.1-10 N). At 10⁻⁷ (the
+/// previous value) the 1 ms implicit step took two or three kept-factor iterations where one
+/// now suffices (experiments/benchmarks/bench_springs.cpp; docs/spring-network.md §2).
+constexpr double newton_tolerance = 1e-5;
 /// Sub-steps beyond this in one sample are reported as over budget.
 constexpr int max_substeps = 100000;
 
@@ -222,6 +226,7 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   m_initial = std::move(net);
   m_omega_max = highest_angular_frequency(m_initial);
   m_stability_limit = symplectic_euler_stability_limit(m_omega_max, m_initial.damping_time);
+  m_lattice = LatticeForces(m_initial);
   m_gershgorin_work.assign(static_cast<std::size_t>(m_initial.node_capacity()), 0.0);
   m_gershgorin_rest = gershgorin_frequency_bound(m_initial, m_initial.rest, m_gershgorin_work);
 }
@@ -236,7 +241,6 @@ void SpringNetworkModel::reset() {
   m_x = m_net.rest;
   m_v.setZero(3, cap);
   m_f.setZero(3, cap);
-  m_zero.setZero(3, cap);
   m_last_tool.assign(m_setup.styluses.size(), Eigen::Vector3d::Zero());
   m_started = false;
   m_tears = 0;
@@ -246,8 +250,6 @@ void SpringNetworkModel::reset() {
   m_piece_label.assign(static_cast<std::size_t>(m_net.cell_count()), 0);
   m_pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
   m_newton.reset();
-  // Newton tolerance: the force of an edge spring stretched by 10⁻⁷ of its length (4·10⁻⁸ N on
-  // the clay scenes' 2.5 mm cells), far below what a haptic device renders.
   if (m_setup.integrator == SpringIntegrator::implicit_euler)
     m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::implicit_euler, 8, newton_tolerance);
   else if (m_setup.integrator == SpringIntegrator::quasi_static)
@@ -290,7 +292,7 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
     const double h = dt / substeps;
     for (int k = 1; k <= substeps; ++k) {
       place_attached(static_cast<double>(k) / substeps);
-      symplectic_euler_step(m_net, m_x, m_v, h, m_f);
+      symplectic_euler_step(m_net, m_x, m_v, h, m_lattice, m_f);
     }
     m_last_substeps = substeps;
   } else {
@@ -302,8 +304,12 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
   }
   for (int t = 0; t < n_tools; ++t) m_last_tool[static_cast<std::size_t>(t)] = tools[static_cast<std::size_t>(t)].position;
 
-  // The force on each stylus: the sum of the internal forces on its attached nodes.
-  network_forces(m_net, m_x, m_setup.integrator == SpringIntegrator::quasi_static ? m_zero : m_v, m_f);
+  // The force on each stylus: the sum of the internal forces on its attached nodes (at the end
+  // of the sample; the Newton stepper's last residual evaluation already holds them).
+  if (m_newton)
+    m_f.leftCols(m_net.node_count) = m_newton->forces().leftCols(m_net.node_count);
+  else
+    m_lattice.evaluate(m_net, m_x, m_v, m_f);
   bool finite = m_x.leftCols(m_net.node_count).allFinite();
   for (int t = 0; t < n_tools; ++t) forces[static_cast<std::size_t>(t)] = ForceSample{Eigen::Vector3d::Zero(), InteractionMode::deformation_1, 0.0, over_budget};
   for (int p = 0; p < m_net.node_count; ++p)

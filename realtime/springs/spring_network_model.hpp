@@ -109,7 +109,7 @@ private:
   SpringNetwork m_initial, m_net;
   std::vector<int> m_attached_to;        ///< per node: stylus index or -1
   std::vector<std::uint8_t> m_excluded;  ///< per node: not torn (attached)
-  Eigen::Matrix3Xd m_x, m_v, m_f, m_zero;
+  Eigen::Matrix3Xd m_x, m_v, m_f;
   std::vector<Eigen::Vector3d> m_last_tool;
   bool m_started = false;
   double m_omega_max = 0.0;
@@ -120,6 +120,7 @@ private:
   int m_tears = 0;
   long m_factorisations = 0;
   int m_pieces = 1;
+  LatticeForces m_lattice;               ///< the explicit integrator's force loops
   std::unique_ptr<NewtonStepper> m_newton;
   std::unique_ptr<VertexTearing> m_tearing;
   std::vector<int> m_piece_parent, m_piece_label;

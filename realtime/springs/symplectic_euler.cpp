@@ -81,9 +81,10 @@ double gershgorin_frequency_bound(const SpringNetwork& net, const Eigen::Matrix3
   return bound;
 }
 
-double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
-                             Eigen::Matrix3Xd& f) noexcept {
-  const double energy = network_forces(net, x, v, f);
+namespace {
+/// v ← v + h f / m, then x ← x + h v, on the free axes.
+void symplectic_euler_update(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
+                             const Eigen::Matrix3Xd& f) noexcept {
   for (int p = 0; p < net.node_count; ++p) {
     const std::uint8_t fixed = net.constraint[static_cast<std::size_t>(p)];
     const double inv_m = 1.0 / net.mass[static_cast<std::size_t>(p)];
@@ -94,6 +95,20 @@ double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eige
       x(i, p) += h * v(i, p);
     }
   }
+}
+} // namespace
+
+double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
+                             Eigen::Matrix3Xd& f) noexcept {
+  const double energy = network_forces(net, x, v, f);
+  symplectic_euler_update(net, x, v, h, f);
+  return energy;
+}
+
+double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
+                             LatticeForces& forces, Eigen::Matrix3Xd& f) noexcept {
+  const double energy = forces.evaluate(net, x, v, f);
+  symplectic_euler_update(net, x, v, h, f);
   return energy;
 }
 
