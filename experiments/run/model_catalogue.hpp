@@ -44,6 +44,11 @@ struct BuiltModel {
   /// Optional: what the model writes into a run's directory after the last step (the edge
   /// model's cut mesh); returns the entries it adds to the run's manifest. Not realtime.
   std::function<nlohmann::json(const std::filesystem::path& dir)> write_outputs = {};
+  /// When `model` wraps the model proper (the springs run records the network for its .vtu
+  /// series), the model proper (owned by `model`); else null. Code that looks for a concrete
+  /// model type (the viewer's adapters) reads `core_model()`.
+  ToolModel* core = nullptr;
+  [[nodiscard]] const ToolModel& core_model() const { return core ? *core : *model; }
 };
 
 /// Checks, before any meshing, that model `name` exists and can represent `scene`: it covers
