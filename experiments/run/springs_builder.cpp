@@ -136,12 +136,16 @@ constexpr int series_frames = 100;
 
 void require_springs_inputs(const Scene& scene) {
   if (scene.tools.empty() || scene.tools.size() > 2)
-    throw ModelMismatch("model springs needs one or two sphere (stylus) tools; scene " + scene.name + " has " +
+    throw ModelMismatch("model springs needs one or two sphere (stylus) tools, or one blade; scene " + scene.name + " has " +
                         std::to_string(scene.tools.size()));
   for (const Tool& t : scene.tools)
-    if (t.kind != Tool::Kind::sphere)
-      throw ModelMismatch("model springs takes sphere (stylus) tools only (paper 000 §2: the stylus tip grasps the "
-                          "body); tool \"" + t.name + "\" of scene " + scene.name + " is a blade");
+    if (t.kind == Tool::Kind::blade && scene.tools.size() != 1)
+      throw ModelMismatch("model springs takes a blade alone (the deformation phase of a one-blade cutting scene); "
+                          "scene " + scene.name + " has " + std::to_string(scene.tools.size()) + " tools");
+  if (scene.tools.front().kind == Tool::Kind::sphere && (scene.phenomena.contains(Phenomenon::cutting) ||
+                                                          scene.phenomena.contains(Phenomenon::friction)))
+    throw ModelMismatch("model springs represents cutting scenes only through a blade's deformation phase; scene " +
+                        scene.name + " cuts with a sphere");
   if (scene.phenomena.contains(Phenomenon::tearing) && !(scene.material.cohesive_strength > 0.0) &&
       !(scene.springs && scene.springs->tensile_limit))
     throw ModelMismatch("model springs tears at [models.springs] tensile_limit or the material's cohesive_strength, neither of "
@@ -173,7 +177,16 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
   setup.tearing = scene.phenomena.contains(Phenomenon::tearing);
   setup.tensile_limit = setup.tearing ? settings.tensile_limit.value_or(m.cohesive_strength) : 0.0;
   for (const Support& s : scene.supports) setup.supports.push_back({s.surface, s.kind == Support::Kind::sliding});
-  for (const Tool& t : scene.tools) setup.styluses.push_back({t.trajectory.start, t.radius});
+  for (const Tool& t : scene.tools) {
+    if (t.kind == Tool::Kind::blade) {
+      setup.styluses.push_back({t.trajectory.start, 0.0, SpringBladeEdge{t.blade.edge_direction, t.blade.cutting_direction, t.blade.edge_length}});
+      // A blade crushes the cells under its edge: backward Euler unless the scene or the
+      // command line says otherwise (the explicit limit shrinks with the crushed springs).
+      if (!settings.integrator && options.find("integrator") == options.end()) setup.integrator = SpringIntegrator::implicit_euler;
+    } else {
+      setup.styluses.push_back({t.trajectory.start, t.radius});
+    }
+  }
 
   double duration = 0.0;
   for (const Tool& t : scene.tools) duration = std::max(duration, sample(t.trajectory).duration());

@@ -131,6 +131,15 @@ SpringNetworkModel::SpringNetworkModel(const TetMesh& mesh, SpringNetworkSetup s
   const SpringNetworkSetup& s = m_setup;
   if (s.styluses.empty() || s.styluses.size() > 2)
     throw std::invalid_argument("springs: needs one or two styluses, got " + std::to_string(s.styluses.size()));
+  for (const SpringStylus& t : s.styluses)
+    if (t.blade) {
+      if (s.styluses.size() != 1) throw std::invalid_argument("springs: a blade is taken alone (one tool)");
+      const SpringBladeEdge& b = *t.blade;
+      if (!(b.length > 0.0)) throw std::invalid_argument("springs: the blade's edge length must be > 0 m");
+      if (std::abs(b.edge_direction.norm() - 1.0) > 1e-9 || std::abs(b.cutting_direction.norm() - 1.0) > 1e-9 ||
+          std::abs(b.edge_direction.dot(b.cutting_direction)) > 1e-9)
+        throw std::invalid_argument("springs: the blade's edge and cutting directions must be orthogonal unit vectors");
+    }
   if (s.cells < 1) throw std::invalid_argument("springs: cells per block side must be >= 1, got " + std::to_string(s.cells));
   if (!(s.cell_size >= 0.0)) throw std::invalid_argument("springs: cell size must be >= 0 (0: automatic)");
   if (!(s.damping >= 0.0)) throw std::invalid_argument("springs: damping must be >= 0 Pa s");
@@ -156,7 +165,11 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   double spread = 0.0;
   for (const auto& a : contact)
     for (const auto& b : contact) spread = std::max(spread, (a - b).norm());
-  const double h = s.cell_size > 0.0 ? s.cell_size : std::max(extent.minCoeff(), 2.0 * spread) / s.cells;
+  // A blade's reach: its edge's span within the body's box.
+  double reach = 2.0 * spread;
+  for (const SpringStylus& t : s.styluses)
+    if (t.blade) reach = std::max(reach, std::min(t.blade->length, extent.dot(t.blade->edge_direction.cwiseAbs())));
+  const double h = s.cell_size > 0.0 ? s.cell_size : std::max(extent.minCoeff(), reach) / s.cells;
   const double side = h * s.cells;
   NetworkBlock block;
   block.cell_size = h;
@@ -202,8 +215,34 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
 
   // 4. Nodes under each stylus tip are attached to it.
   m_attached_to.assign(static_cast<std::size_t>(net.node_capacity()), -1);
+  m_gap.assign(static_cast<std::size_t>(net.node_capacity()), 0.0);
   for (int t = 0; t < static_cast<int>(s.styluses.size()); ++t) {
     const SpringStylus& stylus = s.styluses[static_cast<std::size_t>(t)];
+    if (stylus.blade) {
+      // The nodes under the edge: within its span and h/2 of its plane, ahead of it along c.
+      const Eigen::Vector3d& e = stylus.blade->edge_direction;
+      const Eigen::Vector3d& c = stylus.blade->cutting_direction;
+      const Eigen::Vector3d lateral = c.cross(e);
+      const double tolerance = 1e-9 * h;
+      std::vector<int> under;
+      double first = INFINITY;
+      for (int p = 0; p < net.node_count; ++p) {
+        const Eigen::Vector3d u = net.rest.col(p) - stylus.start;
+        if (std::abs(u.dot(e)) <= 0.5 * stylus.blade->length + tolerance && std::abs(u.dot(lateral)) <= 0.5 * h + tolerance &&
+            u.dot(c) >= -tolerance) {
+          under.push_back(p);
+          first = std::min(first, u.dot(c));
+        }
+      }
+      // The first layer the edge meets.
+      for (int p : under)
+        if (const double gap = (net.rest.col(p) - stylus.start).dot(c); gap <= first + 0.5 * h) {
+          m_attached_to[static_cast<std::size_t>(p)] = t;
+          m_gap[static_cast<std::size_t>(p)] = std::max(gap, 0.0);
+        }
+      if (under.empty()) throw std::invalid_argument("springs: no network node lies under the blade's edge");
+      continue;
+    }
     int nearest = -1;
     double nearest_distance = INFINITY;
     int count = 0;
@@ -274,7 +313,17 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
       if (t < 0) continue;
       const Eigen::Vector3d& from = m_last_tool[static_cast<std::size_t>(t)];
       const Eigen::Vector3d& to = tools[static_cast<std::size_t>(t)].position;
-      const Eigen::Vector3d target = m_net.rest.col(p) + (from + s * (to - from)) - m_setup.styluses[static_cast<std::size_t>(t)].start;
+      const SpringStylus& tool = m_setup.styluses[static_cast<std::size_t>(t)];
+      if (tool.blade) {
+        // x = X + c max(0, (p − p₀)·c − g): the node stays until the edge reaches it.
+        const Eigen::Vector3d& c = tool.blade->cutting_direction;
+        const double gap = m_gap[static_cast<std::size_t>(p)];
+        const auto push = [&](const Eigen::Vector3d& at) { return std::max(0.0, (at - tool.start).dot(c) - gap); };
+        m_x.col(p) = m_net.rest.col(p) + push(from + s * (to - from)) * c;
+        m_v.col(p) = (push(to) - push(from)) / dt * c;
+        continue;
+      }
+      const Eigen::Vector3d target = m_net.rest.col(p) + (from + s * (to - from)) - tool.start;
       m_v.col(p) = (to - from) / dt;
       m_x.col(p) = target;
     }

@@ -55,6 +55,20 @@ TEST(RealtimeContract, SpringNetworkStepAllocatesNothing) {
   }
 }
 
+TEST(RealtimeContract, BladePressAllocatesNothing) {
+  // The deformation phase of a cutting scene: a blade edge pressed 1.5 mm into a prism.
+  const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.04, 0.01, 0.015}, 16, 8, 6);
+  for (const SpringIntegrator integrator : {SpringIntegrator::symplectic_euler, SpringIntegrator::implicit_euler}) {
+    SpringNetworkSetup s = test::clay_pull_setup(integrator);
+    s.styluses = {{Eigen::Vector3d(0.02, 0.0, 0.016), 0.0, SpringBladeEdge{Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ(), 0.03}}};
+    SpringNetworkModel model(mesh, s);
+    std::vector<std::vector<ToolState>> path(301, std::vector<ToolState>(1));
+    for (int k = 0; k <= 300; ++k) path[static_cast<std::size_t>(k)][0].position = {0.02, 0.0, 0.016 - 1e-5 * k};
+    EXPECT_EQ(allocations_while_stepping(model, 300, [&](int k) -> const std::vector<ToolState>& { return path[static_cast<std::size_t>(k)]; }), 0)
+        << to_string(integrator);
+  }
+}
+
 TEST(RealtimeContract, ExplicitTearingAllocatesNothing) {
   // clay_tear: 60 x 20 x 20 mm on a table, styluses at x = 15 and 45 mm pulled 10 mm apart each.
   const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.06, 0.01, 0.02}, 12, 4, 4);
