@@ -139,34 +139,48 @@ double NetworkSystem::factor_entries() const {
   return m_factor->is_super ? static_cast<double>(m_factor->xsize) : static_cast<double>(m_factor->nzmax);
 }
 
-void NetworkSystem::rebuild(const SpringNetwork& net) {
+void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   release();
   m_factorized = false;
-  // Free dofs in node order first.
+  // Free dofs in node order first, then (tear-ready) one shadow per free dof of every node.
   std::vector<int> natural(static_cast<std::size_t>(3 * net.node_capacity()), -1);
+  std::vector<int> shadow_natural(natural.size(), -1);
   int n = 0;
   for (int p = 0; p < net.node_count; ++p)
     for (int i = 0; i < 3; ++i)
       if (!(net.constraint[static_cast<std::size_t>(p)] & (1u << i))) natural[static_cast<std::size_t>(3 * p + i)] = n++;
-  const auto dof = [&net](const std::vector<int>& map, int cell, int a) {
-    return map[static_cast<std::size_t>(3 * net.cell_nodes[static_cast<std::size_t>(cell)][static_cast<std::size_t>(a / 3)] + a % 3)];
+  const int first_shadow = n;
+  if (tear_ready)
+    for (int p = 0; p < net.node_count; ++p)
+      for (int i = 0; i < 3; ++i)
+        if (natural[static_cast<std::size_t>(3 * p + i)] >= 0) shadow_natural[static_cast<std::size_t>(3 * p + i)] = n++;
+  // Local dof a (3 corner + axis) of a cell: the node's dof and its shadow's, either may be −1.
+  const auto dofs = [&net](const std::vector<int>& map, const std::vector<int>& shadow, int cell, int a) {
+    const auto k = static_cast<std::size_t>(3 * net.cell_nodes[static_cast<std::size_t>(cell)][static_cast<std::size_t>(a / 3)] + a % 3);
+    return std::array<int, 2>{map[k], shadow[k]};
   };
-  const auto lower_pattern = [&](const std::vector<int>& map) {
+  const auto lower_pattern = [&](const std::vector<int>& map, const std::vector<int>& shadow) {
     std::vector<Eigen::Triplet<double, int>> triplets;
-    triplets.reserve(static_cast<std::size_t>(net.cell_count()) * 300);
+    triplets.reserve(static_cast<std::size_t>(net.cell_count()) * (tear_ready ? 1200 : 300));
     for (int cell = 0; cell < net.cell_count(); ++cell)
-      for (int a = 0; a < 24; ++a) {
-        const int r = dof(map, cell, a);
-        if (r < 0) continue;
-        for (int b = 0; b < 24; ++b)
-          if (const int c = dof(map, cell, b); c >= 0 && r >= c) triplets.emplace_back(r, c, 1.0);
-      }
+      for (int a = 0; a < 24; ++a)
+        for (const int r : dofs(map, shadow, cell, a)) {
+          if (r < 0) continue;
+          for (int b = 0; b < 24; ++b)
+            for (const int c : dofs(map, shadow, cell, b))
+              if (c >= 0 && r >= c) triplets.emplace_back(r, c, 1.0);
+        }
     Matrix m(n, n);
     m.setFromTriplets(triplets.begin(), triplets.end());
     m.makeCompressed();
     return m;
   };
-  m_matrix = lower_pattern(natural);
+  m_matrix = lower_pattern(natural, shadow_natural);
+  m_bound_cells = net.cell_nodes;
+  m_bound_nodes = net.node_count;
+  m_node_at_point.clear();
+  m_shadow_of.assign(natural.size(), -1);
+  m_dof_in_use.assign(static_cast<std::size_t>(n), 1);
   if (n == 0) {
     m_dof_of.assign(natural.size(), -1);
     m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
@@ -202,27 +216,31 @@ void NetworkSystem::rebuild(const SpringNetwork& net) {
   std::vector<int> new_of_natural(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) new_of_natural[static_cast<std::size_t>(perm[k])] = k;
   m_dof_of.assign(natural.size(), -1);
-  for (std::size_t k = 0; k < natural.size(); ++k)
+  for (std::size_t k = 0; k < natural.size(); ++k) {
     if (natural[k] >= 0) m_dof_of[k] = new_of_natural[static_cast<std::size_t>(natural[k])];
+    if (shadow_natural[k] >= 0) m_shadow_of[k] = new_of_natural[static_cast<std::size_t>(shadow_natural[k])];
+  }
+  // Shadows are unused until a copy takes them: a unit diagonal keeps A positive definite.
+  for (int k = first_shadow; k < n; ++k) m_dof_in_use[static_cast<std::size_t>(new_of_natural[static_cast<std::size_t>(k)])] = 0;
+  if (tear_ready) {
+    // The node at each lattice point, for finding the original of a copy (same rest position).
+    const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
+    m_node_at_point.assign(static_cast<std::size_t>(np.prod()), -1);
+    for (int p = 0; p < net.node_count; ++p) {
+      const Eigen::Vector3i g = ((net.rest.col(p) - net.block.origin) / net.block.cell_size).array().round().cast<int>();
+      if ((g.array() < 0).any() || (g.array() >= np.array()).any()) throw std::invalid_argument("NetworkSystem: a node off the block's lattice");
+      int& at = m_node_at_point[static_cast<std::size_t>(g.x() + np.x() * (g.y() + np.y() * g.z()))];
+      if (at >= 0) throw std::invalid_argument("NetworkSystem: a tear-ready pattern needs an untorn network");
+      at = p;
+    }
+  }
 
   // Lower-triangular pattern in the factor's order, and each cell entry's place in it.
-  m_matrix = lower_pattern(m_dof_of);
-  const auto index_of = [this](int r, int c) {
-    const int* rows = m_matrix.innerIndexPtr();
-    const int begin = m_matrix.outerIndexPtr()[c], end = m_matrix.outerIndexPtr()[c + 1];
-    return static_cast<int>(std::lower_bound(rows + begin, rows + end, r) - rows);
-  };
+  m_matrix = lower_pattern(m_dof_of, m_shadow_of);
   m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
-  for (int cell = 0; cell < net.cell_count(); ++cell)
-    for (int a = 0; a < 24; ++a) {
-      const int r = dof(m_dof_of, cell, a);
-      if (r < 0) continue;
-      for (int b = 0; b < 24; ++b)
-        if (const int c = dof(m_dof_of, cell, b); c >= 0 && r >= c)
-          m_entry[static_cast<std::size_t>(cell) * 576 + static_cast<std::size_t>(24 * a + b)] = index_of(r, c);
-    }
+  for (int cell = 0; cell < net.cell_count(); ++cell) bind_cell(net, cell);
   m_diagonal.assign(static_cast<std::size_t>(n), -1);
-  for (int k = 0; k < n; ++k) m_diagonal[static_cast<std::size_t>(k)] = index_of(k, k);
+  for (int k = 0; k < n; ++k) m_diagonal[static_cast<std::size_t>(k)] = value_index(k, k);
 
   // The lease for cholmod_super_numeric's temporary: its cholmod_dense header and L->maxcsize
   // entries, with room for alignment.
@@ -260,6 +278,59 @@ void NetworkSystem::assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x
     for (int i = 0; i < 3; ++i)
       if (const int d = m_dof_of[static_cast<std::size_t>(3 * p + i)]; d >= 0)
         values[m_diagonal[static_cast<std::size_t>(d)]] += mass_weight * net.mass[static_cast<std::size_t>(p)];
+  for (std::size_t d = 0; d < m_dof_in_use.size(); ++d)
+    if (!m_dof_in_use[d]) values[m_diagonal[d]] = 1.0; // an unused shadow: decoupled, solution 0
+}
+
+int NetworkSystem::value_index(int r, int c) const noexcept {
+  const int* rows = m_matrix.innerIndexPtr();
+  const int begin = m_matrix.outerIndexPtr()[c], end = m_matrix.outerIndexPtr()[c + 1];
+  const int* at = std::lower_bound(rows + begin, rows + end, r);
+  return at != rows + end && *at == r ? static_cast<int>(at - rows) : -1;
+}
+
+bool NetworkSystem::bind_cell(const SpringNetwork& net, int cell) noexcept {
+  const auto& nodes = net.cell_nodes[static_cast<std::size_t>(cell)];
+  int* entry = m_entry.data() + static_cast<std::size_t>(cell) * 576;
+  bool ok = true;
+  for (int a = 0; a < 24; ++a) {
+    const int r = m_dof_of[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(a / 3)] + a % 3)];
+    for (int b = 0; b < 24; ++b) {
+      const int c = m_dof_of[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(b / 3)] + b % 3)];
+      int& e = entry[24 * a + b];
+      e = r >= 0 && c >= 0 && r >= c ? value_index(r, c) : -1;
+      if (r >= 0 && c >= 0 && r >= c && e < 0) ok = false; // not in the analysed pattern
+    }
+  }
+  return ok;
+}
+
+bool NetworkSystem::bind_split_vertices(const SpringNetwork& net) noexcept {
+  if (m_node_at_point.empty() || net.node_count < m_bound_nodes || net.cell_count() != static_cast<int>(m_bound_cells.size()))
+    return false;
+  const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
+  for (int copy = m_bound_nodes; copy < net.node_count; ++copy) {
+    const Eigen::Vector3i g = ((net.rest.col(copy) - net.block.origin) / net.block.cell_size).array().round().cast<int>();
+    if ((g.array() < 0).any() || (g.array() >= np.array()).any()) return false;
+    const int original = m_node_at_point[static_cast<std::size_t>(g.x() + np.x() * (g.y() + np.y() * g.z()))];
+    if (original < 0) return false;
+    for (int i = 0; i < 3; ++i) {
+      const auto k = static_cast<std::size_t>(3 * original + i);
+      const bool free = !(net.constraint[static_cast<std::size_t>(copy)] & (1u << i));
+      if (free != (m_shadow_of[k] >= 0) || (free && m_dof_in_use[static_cast<std::size_t>(m_shadow_of[k])])) return false;
+      m_dof_of[static_cast<std::size_t>(3 * copy + i)] = free ? m_shadow_of[k] : -1;
+      if (free) m_dof_in_use[static_cast<std::size_t>(m_shadow_of[k])] = 1;
+    }
+  }
+  m_bound_nodes = net.node_count;
+  // Re-place the entries of the cells whose corners changed.
+  for (int cell = 0; cell < net.cell_count(); ++cell)
+    if (net.cell_nodes[static_cast<std::size_t>(cell)] != m_bound_cells[static_cast<std::size_t>(cell)]) {
+      if (!bind_cell(net, cell)) return false;
+      m_bound_cells[static_cast<std::size_t>(cell)] = net.cell_nodes[static_cast<std::size_t>(cell)];
+    }
+  m_factorized = false;
+  return true;
 }
 
 bool NetworkSystem::factorize() noexcept {

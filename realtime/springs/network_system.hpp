@@ -12,6 +12,8 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 struct cholmod_common_struct;
@@ -41,7 +43,20 @@ public:
   /// fill) and the supernodes on the cell-coupling pattern, and sizes every workspace that
   /// `factorize` and `solve` use. Allocates; call again whenever cells, nodes or constraints
   /// change (a tear).
-  void rebuild(const SpringNetwork& net);
+  ///
+  /// `tear_ready`: the pattern also holds a shadow of every free degree of freedom, coupled like
+  /// its node (every pair of nodes sharing a cell couples node and shadow alike), so that a
+  /// vertex split (VertexTearing: the copy takes the original's rest position and constraint,
+  /// each vertex splits once) is bound by `bind_split_vertices` without a new analysis. Unused
+  /// shadows get a unit diagonal (decoupled, solution zero). The factor is larger (about twice
+  /// the dofs). Needs an untorn network.
+  void rebuild(const SpringNetwork& net, bool tear_ready = false);
+
+  /// After vertex splits on a tear-ready system: gives each new node (a copy) its original's
+  /// shadow dofs and re-places the entries of the cells whose corners changed. Allocation-free.
+  /// False if the system is not tear-ready or a split does not fit the shadows (a second copy of
+  /// a vertex, a changed constraint): then `rebuild` is needed.
+  bool bind_split_vertices(const SpringNetwork& net) noexcept;
 
   /// Number of free degrees of freedom.
   [[nodiscard]] int dof_count() const { return static_cast<int>(m_matrix.rows()); }
@@ -69,6 +84,11 @@ public:
 
 private:
   void release() noexcept;
+  /// Index of entry (r, c) of the lower triangle in the matrix's values, or −1.
+  [[nodiscard]] int value_index(int r, int c) const noexcept;
+  /// The value slots of one cell's 24 x 24 entries from its current corners; false if one is
+  /// missing from the pattern.
+  bool bind_cell(const SpringNetwork& net, int cell) noexcept;
 
   std::vector<int> m_dof_of;
   Matrix m_matrix;
@@ -76,6 +96,11 @@ private:
   /// upper triangle).
   std::vector<int> m_entry;
   std::vector<int> m_diagonal; ///< value index of each dof's diagonal
+  std::vector<int> m_shadow_of;             ///< tear-ready: shadow dof of node n's axis i (3 n + i), or −1
+  std::vector<std::uint8_t> m_dof_in_use;   ///< per dof: 0 for a shadow no copy has taken yet
+  std::vector<int> m_node_at_point;         ///< tear-ready: the original node at each lattice point
+  std::vector<std::array<int, 8>> m_bound_cells; ///< the cell corners the entries were placed for
+  int m_bound_nodes = 0;
   cholmod_common_struct* m_common = nullptr;
   cholmod_factor_struct* m_factor = nullptr;
   SolvePrecision m_precision;

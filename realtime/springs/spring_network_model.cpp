@@ -290,9 +290,9 @@ void SpringNetworkModel::reset() {
   m_pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
   m_newton.reset();
   if (m_setup.integrator == SpringIntegrator::implicit_euler)
-    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::implicit_euler, 8, newton_tolerance);
+    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::implicit_euler, 8, newton_tolerance, m_setup.tearing);
   else if (m_setup.integrator == SpringIntegrator::quasi_static)
-    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::quasi_static, 30, newton_tolerance);
+    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::quasi_static, 30, newton_tolerance, m_setup.tearing);
   m_tearing = m_setup.tearing ? std::make_unique<VertexTearing>(m_net, m_setup.tensile_limit) : nullptr;
 }
 
@@ -366,7 +366,9 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
 
   if (m_tearing && finite && m_tearing->tear(m_net, m_x, m_v, m_excluded)) {
     ++m_tears;
-    if (m_newton) m_newton->rebuild(m_net);
+    // The tear-ready pattern takes the split without a new analysis (allocation-free); a split
+    // it cannot take (none is expected: each vertex splits once) re-analyses, which allocates.
+    if (m_newton && !m_newton->retopologise(m_net)) m_newton->rebuild(m_net);
     const int pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
     if (pieces > m_pieces)
       for (ForceSample& f : forces) f.mode = InteractionMode::rupture;

@@ -124,5 +124,57 @@ TEST(NetworkSystem, SolvesAgainstADenseFactorisation) {
   }
 }
 
+TEST(NetworkSystem, TearReadyPatternTakesASplitLikeAFreshAnalysis) {
+  // A vertex split bound into the tear-ready pattern (no new analysis) against a fresh analysis of
+  // the torn network: the same solution of A u = b node by node (A = M/h² + K_T at a displaced
+  // state), the unused shadows decoupled.
+  const double h = 2.5e-3;
+  SpringNetwork net = test::full_block(3, h, identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0);
+  for (int n = 0; n < net.node_count; ++n)
+    if (test::grid_of(net, n).z() == 0) net.constraint[static_cast<std::size_t>(n)] = fix_all;
+  NetworkSystem ready;
+  ready.rebuild(net, true);
+  // Split the node at lattice point (1, 1, 1): cells with grid x = 1 take the copy.
+  int centre = -1;
+  for (int n = 0; n < net.node_count; ++n)
+    if (test::grid_of(net, n) == Eigen::Vector3i(1, 1, 1)) centre = n;
+  ASSERT_GE(centre, 0);
+  const int copy = net.node_count++;
+  net.rest.col(copy) = net.rest.col(centre);
+  net.constraint[static_cast<std::size_t>(copy)] = net.constraint[static_cast<std::size_t>(centre)];
+  for (int c = 0; c < net.cell_count(); ++c)
+    if (net.cell_index[static_cast<std::size_t>(c)].x() == 1)
+      for (int& id : net.cell_nodes[static_cast<std::size_t>(c)]) id = id == centre ? copy : id;
+  net.mass[static_cast<std::size_t>(copy)] = 4 * net.cell_mass / 8.0;
+  net.mass[static_cast<std::size_t>(centre)] = 4 * net.cell_mass / 8.0;
+  merge_springs(net);
+  ASSERT_TRUE(ready.bind_split_vertices(net));
+  EXPECT_TRUE(ready.bind_split_vertices(net)); // binding again with nothing new changes nothing
+  NetworkSystem fresh(net);
+
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::Matrix3Xd x = net.rest, b = Eigen::Matrix3Xd::Zero(3, net.node_capacity());
+  for (int n = 0; n < net.node_count; ++n)
+    for (int i = 0; i < 3; ++i) x(i, n) += 0.02 * h * u(rng), b(i, n) = u(rng);
+  const auto solve = [&](NetworkSystem& system) {
+    system.assemble(net, x, 1e6, 1.0);
+    EXPECT_TRUE(system.factorize());
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(system.dof_count()), out(system.dof_count());
+    for (int n = 0; n < net.node_count; ++n)
+      for (int i = 0; i < 3; ++i)
+        if (const int d = system.dof_of()[static_cast<std::size_t>(3 * n + i)]; d >= 0) rhs[d] = b(i, n);
+    system.solve(rhs, out);
+    Eigen::Matrix3Xd solution = Eigen::Matrix3Xd::Zero(3, net.node_count);
+    for (int n = 0; n < net.node_count; ++n)
+      for (int i = 0; i < 3; ++i)
+        if (const int d = system.dof_of()[static_cast<std::size_t>(3 * n + i)]; d >= 0) solution(i, n) = out[d];
+    return solution;
+  };
+  EXPECT_GT(ready.dof_count(), fresh.dof_count()); // the unused shadows
+  const Eigen::Matrix3Xd a = solve(ready), e = solve(fresh);
+  EXPECT_LT((a - e).cwiseAbs().maxCoeff(), 1e-10 * e.cwiseAbs().maxCoeff());
+}
+
 } // namespace
 } // namespace kerf
