@@ -31,8 +31,10 @@ const CatalogueEntry catalogue[] = {
       PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction},
       "one sphere (cutting stick)"},
      &require_voxel_inputs, &build_voxel_model},
-    {{"springs", "cubic 28-spring network around the stylus(es), E and ν identified, embedding, tearing; --integrator explicit|implicit|static",
-      "paper 000 §2.1, §2.2", PhenomenonSet{Phenomenon::deformation, Phenomenon::tearing}, "one or two spheres (styluses)"},
+    {{"springs", "cubic 28-spring network around the stylus(es), E and ν identified, embedding, tearing; --integrator explicit|implicit|static; "
+                 "on a one-blade cutting scene the deformation phase only (the edge presses the network: no cut, no friction)",
+      "paper 000 §2.1, §2.2", PhenomenonSet{Phenomenon::deformation, Phenomenon::tearing, Phenomenon::cutting, Phenomenon::friction},
+      "one or two spheres (styluses), or one blade (deformation phase)"},
      &require_springs_inputs, nullptr, &build_springs_model},
 };
 

@@ -1,5 +1,7 @@
 #include "realtime/springs/network_system.hpp"
 
+#include "realtime/springs/vector_clones.hpp"
+
 #include <cholmod.h>
 #include <dlfcn.h>
 
@@ -112,7 +114,7 @@ private:
 
 } // namespace
 
-NetworkSystem::NetworkSystem() {
+NetworkSystem::NetworkSystem(SolvePrecision precision) : m_precision(precision) {
   install_lease_hooks();
   m_common = new cholmod_common;
   cholmod_start(m_common);
@@ -120,7 +122,7 @@ NetworkSystem::NetworkSystem() {
   m_common->print = 0;
 }
 
-NetworkSystem::NetworkSystem(const SpringNetwork& net) : NetworkSystem() { rebuild(net); }
+NetworkSystem::NetworkSystem(const SpringNetwork& net, SolvePrecision precision) : NetworkSystem(precision) { rebuild(net); }
 
 NetworkSystem::~NetworkSystem() {
   release();
@@ -130,8 +132,6 @@ NetworkSystem::~NetworkSystem() {
 
 void NetworkSystem::release() noexcept {
   if (m_factor) cholmod_free_factor(&m_factor, m_common);
-  for (cholmod_dense** d : {&m_rhs, &m_solution, &m_work_y, &m_work_e})
-    if (*d) cholmod_free_dense(d, m_common);
 }
 
 double NetworkSystem::factor_entries() const {
@@ -139,35 +139,48 @@ double NetworkSystem::factor_entries() const {
   return m_factor->is_super ? static_cast<double>(m_factor->xsize) : static_cast<double>(m_factor->nzmax);
 }
 
-void NetworkSystem::rebuild(const SpringNetwork& net) {
+void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   release();
   m_factorized = false;
-  // Free dofs in node order first.
+  // Free dofs in node order first, then (tear-ready) one shadow per free dof of every node.
   std::vector<int> natural(static_cast<std::size_t>(3 * net.node_capacity()), -1);
+  std::vector<int> shadow_natural(natural.size(), -1);
   int n = 0;
   for (int p = 0; p < net.node_count; ++p)
     for (int i = 0; i < 3; ++i)
       if (!(net.constraint[static_cast<std::size_t>(p)] & (1u << i))) natural[static_cast<std::size_t>(3 * p + i)] = n++;
-  const auto dof = [&net](const std::vector<int>& map, int cell, int a) {
-    return map[static_cast<std::size_t>(3 * net.cell_nodes[static_cast<std::size_t>(cell)][static_cast<std::size_t>(a / 3)] + a % 3)];
+  const int first_shadow = n;
+  if (tear_ready)
+    for (int p = 0; p < net.node_count; ++p)
+      for (int i = 0; i < 3; ++i)
+        if (natural[static_cast<std::size_t>(3 * p + i)] >= 0) shadow_natural[static_cast<std::size_t>(3 * p + i)] = n++;
+  // Local dof a (3 corner + axis) of a cell: the node's dof and its shadow's, either may be −1.
+  const auto dofs = [&net](const std::vector<int>& map, const std::vector<int>& shadow, int cell, int a) {
+    const auto k = static_cast<std::size_t>(3 * net.cell_nodes[static_cast<std::size_t>(cell)][static_cast<std::size_t>(a / 3)] + a % 3);
+    return std::array<int, 2>{map[k], shadow[k]};
   };
-  const auto lower_pattern = [&](const std::vector<int>& map) {
+  const auto lower_pattern = [&](const std::vector<int>& map, const std::vector<int>& shadow) {
     std::vector<Eigen::Triplet<double, int>> triplets;
-    triplets.reserve(static_cast<std::size_t>(net.cell_count()) * 300);
+    triplets.reserve(static_cast<std::size_t>(net.cell_count()) * (tear_ready ? 1200 : 300));
     for (int cell = 0; cell < net.cell_count(); ++cell)
-      for (int a = 0; a < 24; ++a) {
-        const int r = dof(map, cell, a);
-        if (r < 0) continue;
-        for (int b = 0; b < 24; ++b)
-          if (const int c = dof(map, cell, b); c >= 0 && r >= c) triplets.emplace_back(r, c, 1.0);
-      }
+      for (int a = 0; a < 24; ++a)
+        for (const int r : dofs(map, shadow, cell, a)) {
+          if (r < 0) continue;
+          for (int b = 0; b < 24; ++b)
+            for (const int c : dofs(map, shadow, cell, b))
+              if (c >= 0 && r >= c) triplets.emplace_back(r, c, 1.0);
+        }
     Matrix m(n, n);
     m.setFromTriplets(triplets.begin(), triplets.end());
     m.makeCompressed();
     return m;
   };
-  m_matrix = lower_pattern(natural);
-  m_rhs = cholmod_allocate_dense(static_cast<std::size_t>(n), 1, static_cast<std::size_t>(n), CHOLMOD_REAL, m_common);
+  m_matrix = lower_pattern(natural, shadow_natural);
+  m_bound_cells = net.cell_nodes;
+  m_bound_nodes = net.node_count;
+  m_node_at_point.clear();
+  m_shadow_of.assign(natural.size(), -1);
+  m_dof_in_use.assign(static_cast<std::size_t>(n), 1);
   if (n == 0) {
     m_dof_of.assign(natural.size(), -1);
     m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
@@ -203,36 +216,45 @@ void NetworkSystem::rebuild(const SpringNetwork& net) {
   std::vector<int> new_of_natural(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) new_of_natural[static_cast<std::size_t>(perm[k])] = k;
   m_dof_of.assign(natural.size(), -1);
-  for (std::size_t k = 0; k < natural.size(); ++k)
+  for (std::size_t k = 0; k < natural.size(); ++k) {
     if (natural[k] >= 0) m_dof_of[k] = new_of_natural[static_cast<std::size_t>(natural[k])];
+    if (shadow_natural[k] >= 0) m_shadow_of[k] = new_of_natural[static_cast<std::size_t>(shadow_natural[k])];
+  }
+  // Shadows are unused until a copy takes them: a unit diagonal keeps A positive definite.
+  for (int k = first_shadow; k < n; ++k) m_dof_in_use[static_cast<std::size_t>(new_of_natural[static_cast<std::size_t>(k)])] = 0;
+  if (tear_ready) {
+    // The node at each lattice point, for finding the original of a copy (same rest position).
+    const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
+    m_node_at_point.assign(static_cast<std::size_t>(np.prod()), -1);
+    for (int p = 0; p < net.node_count; ++p) {
+      const Eigen::Vector3i g = ((net.rest.col(p) - net.block.origin) / net.block.cell_size).array().round().cast<int>();
+      if ((g.array() < 0).any() || (g.array() >= np.array()).any()) throw std::invalid_argument("NetworkSystem: a node off the block's lattice");
+      int& at = m_node_at_point[static_cast<std::size_t>(g.x() + np.x() * (g.y() + np.y() * g.z()))];
+      if (at >= 0) throw std::invalid_argument("NetworkSystem: a tear-ready pattern needs an untorn network");
+      at = p;
+    }
+  }
 
   // Lower-triangular pattern in the factor's order, and each cell entry's place in it.
-  m_matrix = lower_pattern(m_dof_of);
-  const auto index_of = [this](int r, int c) {
-    const int* rows = m_matrix.innerIndexPtr();
-    const int begin = m_matrix.outerIndexPtr()[c], end = m_matrix.outerIndexPtr()[c + 1];
-    return static_cast<int>(std::lower_bound(rows + begin, rows + end, r) - rows);
-  };
+  m_matrix = lower_pattern(m_dof_of, m_shadow_of);
   m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
-  for (int cell = 0; cell < net.cell_count(); ++cell)
-    for (int a = 0; a < 24; ++a) {
-      const int r = dof(m_dof_of, cell, a);
-      if (r < 0) continue;
-      for (int b = 0; b < 24; ++b)
-        if (const int c = dof(m_dof_of, cell, b); c >= 0 && r >= c)
-          m_entry[static_cast<std::size_t>(cell) * 576 + static_cast<std::size_t>(24 * a + b)] = index_of(r, c);
-    }
+  for (int cell = 0; cell < net.cell_count(); ++cell) bind_cell(net, cell);
   m_diagonal.assign(static_cast<std::size_t>(n), -1);
-  for (int k = 0; k < n; ++k) m_diagonal[static_cast<std::size_t>(k)] = index_of(k, k);
+  for (int k = 0; k < n; ++k) m_diagonal[static_cast<std::size_t>(k)] = value_index(k, k);
 
   // The lease for cholmod_super_numeric's temporary: its cholmod_dense header and L->maxcsize
   // entries, with room for alignment.
   m_update_buffer.assign(m_factor->maxcsize + (sizeof(cholmod_dense) + 256) / sizeof(double) + 1, 0.0);
-  // One factorisation and solve of the mass matrix sizes the solve's kept workspaces.
+  // The solve's workspaces: the single-precision factor, the rows below the tallest supernode.
+  if (!m_factor->is_super) throw std::runtime_error("NetworkSystem: CHOLMOD did not choose a supernodal factor");
+  m_factor_single.assign(m_precision == SolvePrecision::single_precision ? m_factor->xsize : 0, 0.0f);
+  const int* pi = static_cast<const int*>(m_factor->pi);
+  std::size_t tallest = 1;
+  for (std::size_t sn = 0; sn < m_factor->nsuper; ++sn) tallest = std::max(tallest, static_cast<std::size_t>(pi[sn + 1] - pi[sn]));
+  m_below.assign(tallest, 0.0);
+  // One factorisation of the mass matrix: CHOLMOD sizes what it keeps in Common now.
   assemble(net, net.rest, 1.0, 0.0);
   if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
-  Eigen::VectorXd ones = Eigen::VectorXd::Ones(n), out(n);
-  solve(ones, out);
   m_factorized = false;
 }
 
@@ -256,6 +278,59 @@ void NetworkSystem::assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x
     for (int i = 0; i < 3; ++i)
       if (const int d = m_dof_of[static_cast<std::size_t>(3 * p + i)]; d >= 0)
         values[m_diagonal[static_cast<std::size_t>(d)]] += mass_weight * net.mass[static_cast<std::size_t>(p)];
+  for (std::size_t d = 0; d < m_dof_in_use.size(); ++d)
+    if (!m_dof_in_use[d]) values[m_diagonal[d]] = 1.0; // an unused shadow: decoupled, solution 0
+}
+
+int NetworkSystem::value_index(int r, int c) const noexcept {
+  const int* rows = m_matrix.innerIndexPtr();
+  const int begin = m_matrix.outerIndexPtr()[c], end = m_matrix.outerIndexPtr()[c + 1];
+  const int* at = std::lower_bound(rows + begin, rows + end, r);
+  return at != rows + end && *at == r ? static_cast<int>(at - rows) : -1;
+}
+
+bool NetworkSystem::bind_cell(const SpringNetwork& net, int cell) noexcept {
+  const auto& nodes = net.cell_nodes[static_cast<std::size_t>(cell)];
+  int* entry = m_entry.data() + static_cast<std::size_t>(cell) * 576;
+  bool ok = true;
+  for (int a = 0; a < 24; ++a) {
+    const int r = m_dof_of[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(a / 3)] + a % 3)];
+    for (int b = 0; b < 24; ++b) {
+      const int c = m_dof_of[static_cast<std::size_t>(3 * nodes[static_cast<std::size_t>(b / 3)] + b % 3)];
+      int& e = entry[24 * a + b];
+      e = r >= 0 && c >= 0 && r >= c ? value_index(r, c) : -1;
+      if (r >= 0 && c >= 0 && r >= c && e < 0) ok = false; // not in the analysed pattern
+    }
+  }
+  return ok;
+}
+
+bool NetworkSystem::bind_split_vertices(const SpringNetwork& net) noexcept {
+  if (m_node_at_point.empty() || net.node_count < m_bound_nodes || net.cell_count() != static_cast<int>(m_bound_cells.size()))
+    return false;
+  const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
+  for (int copy = m_bound_nodes; copy < net.node_count; ++copy) {
+    const Eigen::Vector3i g = ((net.rest.col(copy) - net.block.origin) / net.block.cell_size).array().round().cast<int>();
+    if ((g.array() < 0).any() || (g.array() >= np.array()).any()) return false;
+    const int original = m_node_at_point[static_cast<std::size_t>(g.x() + np.x() * (g.y() + np.y() * g.z()))];
+    if (original < 0) return false;
+    for (int i = 0; i < 3; ++i) {
+      const auto k = static_cast<std::size_t>(3 * original + i);
+      const bool free = !(net.constraint[static_cast<std::size_t>(copy)] & (1u << i));
+      if (free != (m_shadow_of[k] >= 0) || (free && m_dof_in_use[static_cast<std::size_t>(m_shadow_of[k])])) return false;
+      m_dof_of[static_cast<std::size_t>(3 * copy + i)] = free ? m_shadow_of[k] : -1;
+      if (free) m_dof_in_use[static_cast<std::size_t>(m_shadow_of[k])] = 1;
+    }
+  }
+  m_bound_nodes = net.node_count;
+  // Re-place the entries of the cells whose corners changed.
+  for (int cell = 0; cell < net.cell_count(); ++cell)
+    if (net.cell_nodes[static_cast<std::size_t>(cell)] != m_bound_cells[static_cast<std::size_t>(cell)]) {
+      if (!bind_cell(net, cell)) return false;
+      m_bound_cells[static_cast<std::size_t>(cell)] = net.cell_nodes[static_cast<std::size_t>(cell)];
+    }
+  m_factorized = false;
+  return true;
 }
 
 bool NetworkSystem::factorize() noexcept {
@@ -283,21 +358,90 @@ bool NetworkSystem::factorize() noexcept {
   }
   if (blas_threads > 1) g_blas_set_threads(blas_threads);
   m_factorized = m_common->status == CHOLMOD_OK && lease.live == 0;
+  if (m_factorized && !m_factor_single.empty()) {
+    const double* lx = static_cast<const double*>(m_factor->x);
+    for (std::size_t k = 0; k < m_factor_single.size(); ++k) m_factor_single[k] = static_cast<float>(lx[k]);
+  }
   return m_factorized;
 }
+
+namespace {
+
+/// L y = b then Lᵀ x = y in place on x, on a supernodal L whose values are `lx` (double or a
+/// single-precision copy; accumulation in double). Supernode s has columns [k1, k2) and a dense
+/// column-major block of nsrow rows (row indices ls[psi ..]): the first nscol rows are its
+/// diagonal triangle, the rest the rows below it. `below` has room for the tallest supernode.
+template <class Value>
+[[gnu::always_inline]] inline void supernodal_solve(const cholmod_factor& L, const Value* lx, double* x, double* below) noexcept {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* px = static_cast<const int*>(L.px);
+  const int* ls = static_cast<const int*>(L.s);
+  const auto nsuper = static_cast<int>(L.nsuper);
+  // Forward: L y = b.
+  for (int s = 0; s < nsuper; ++s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], nsrow = pi[s + 1] - psi;
+    const Value* block = lx + px[s];
+    for (int j = 0; j < nscol; ++j) {
+      const Value* col = block + static_cast<std::ptrdiff_t>(j) * nsrow;
+      const double xj = x[k1 + j] /= static_cast<double>(col[j]);
+#pragma omp simd
+      for (int i = j + 1; i < nscol; ++i) x[k1 + i] -= static_cast<double>(col[i]) * xj;
+    }
+    const int m = nsrow - nscol;
+    if (m == 0) continue;
+    std::fill(below, below + m, 0.0);
+    for (int j = 0; j < nscol; ++j) {
+      const Value* col = block + static_cast<std::ptrdiff_t>(j) * nsrow + nscol;
+      const double xj = x[k1 + j];
+#pragma omp simd
+      for (int i = 0; i < m; ++i) below[i] += static_cast<double>(col[i]) * xj;
+    }
+    for (int i = 0; i < m; ++i) x[ls[psi + nscol + i]] -= below[i];
+  }
+  // Backward: Lᵀ x = y.
+  for (int s = nsuper - 1; s >= 0; --s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], nsrow = pi[s + 1] - psi;
+    const Value* block = lx + px[s];
+    const int m = nsrow - nscol;
+    for (int i = 0; i < m; ++i) below[i] = x[ls[psi + nscol + i]];
+    for (int j = 0; j < nscol; ++j) {
+      const Value* col = block + static_cast<std::ptrdiff_t>(j) * nsrow + nscol;
+      double dot = 0.0;
+#pragma omp simd reduction(+ : dot)
+      for (int i = 0; i < m; ++i) dot += static_cast<double>(col[i]) * below[i];
+      x[k1 + j] -= dot;
+    }
+    for (int j = nscol - 1; j >= 0; --j) {
+      const Value* col = block + static_cast<std::ptrdiff_t>(j) * nsrow;
+      double dot = 0.0;
+#pragma omp simd reduction(+ : dot)
+      for (int i = j + 1; i < nscol; ++i) dot += static_cast<double>(col[i]) * x[k1 + i];
+      x[k1 + j] = (x[k1 + j] - dot) / static_cast<double>(col[j]);
+    }
+  }
+}
+
+KERF_VECTOR_CLONES
+void supernodal_solve_double(const cholmod_factor& L, const double* lx, double* x, double* below) noexcept {
+  supernodal_solve(L, lx, x, below);
+}
+KERF_VECTOR_CLONES
+void supernodal_solve_single(const cholmod_factor& L, const float* lx, double* x, double* below) noexcept {
+  supernodal_solve(L, lx, x, below);
+}
+
+} // namespace
 
 void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept {
   const int n = dof_count();
   if (n == 0) return;
-  double* b = static_cast<double*>(m_rhs->x);
-  std::copy(rhs.data(), rhs.data() + n, b);
-  // L Lᵀ out = rhs: the system is in the factor's order already, so no permutation (CHOLMOD_LDLt).
-  const int blas_threads = g_blas_get_threads ? g_blas_get_threads() : 1;
-  if (blas_threads > 1) g_blas_set_threads(1);
-  cholmod_solve2(CHOLMOD_LDLt, m_factor, m_rhs, nullptr, &m_solution, nullptr, &m_work_y, &m_work_e, m_common);
-  if (blas_threads > 1) g_blas_set_threads(blas_threads);
-  const double* x = static_cast<const double*>(m_solution->x);
-  std::copy(x, x + n, out.data());
+  // The system is in the factor's order already: no permutation.
+  std::copy(rhs.data(), rhs.data() + n, out.data());
+  if (m_factor_single.empty())
+    supernodal_solve_double(*m_factor, static_cast<const double*>(m_factor->x), out.data(), m_below.data());
+  else
+    supernodal_solve_single(*m_factor, m_factor_single.data(), out.data(), m_below.data());
 }
 
 } // namespace kerf

@@ -12,11 +12,12 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <array>
+#include <cstdint>
 #include <vector>
 
 struct cholmod_common_struct;
 struct cholmod_factor_struct;
-struct cholmod_dense_struct;
 
 namespace kerf {
 
@@ -25,9 +26,14 @@ public:
   /// Lower triangle stored, rows and columns in the factor's (fill-reducing) order.
   using Matrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-  NetworkSystem();
+  /// What the triangular solves read: CHOLMOD's factor itself, or a single-precision copy of it
+  /// (half the memory traffic, which bounds the solve; for a factor used as the approximate
+  /// Jacobian of modified Newton, whose residual is evaluated in double precision).
+  enum class SolvePrecision { double_precision, single_precision };
+
+  explicit NetworkSystem(SolvePrecision precision = SolvePrecision::double_precision);
   /// Builds the pattern for `net` (see `rebuild`).
-  explicit NetworkSystem(const SpringNetwork& net);
+  explicit NetworkSystem(const SpringNetwork& net, SolvePrecision precision = SolvePrecision::double_precision);
   ~NetworkSystem();
   NetworkSystem(const NetworkSystem&) = delete;
   NetworkSystem& operator=(const NetworkSystem&) = delete;
@@ -37,7 +43,20 @@ public:
   /// fill) and the supernodes on the cell-coupling pattern, and sizes every workspace that
   /// `factorize` and `solve` use. Allocates; call again whenever cells, nodes or constraints
   /// change (a tear).
-  void rebuild(const SpringNetwork& net);
+  ///
+  /// `tear_ready`: the pattern also holds a shadow of every free degree of freedom, coupled like
+  /// its node (every pair of nodes sharing a cell couples node and shadow alike), so that a
+  /// vertex split (VertexTearing: the copy takes the original's rest position and constraint,
+  /// each vertex splits once) is bound by `bind_split_vertices` without a new analysis. Unused
+  /// shadows get a unit diagonal (decoupled, solution zero). The factor is larger (about twice
+  /// the dofs). Needs an untorn network.
+  void rebuild(const SpringNetwork& net, bool tear_ready = false);
+
+  /// After vertex splits on a tear-ready system: gives each new node (a copy) its original's
+  /// shadow dofs and re-places the entries of the cells whose corners changed. Allocation-free.
+  /// False if the system is not tear-ready or a split does not fit the shadows (a second copy of
+  /// a vertex, a changed constraint): then `rebuild` is needed.
+  bool bind_split_vertices(const SpringNetwork& net) noexcept;
 
   /// Number of free degrees of freedom.
   [[nodiscard]] int dof_count() const { return static_cast<int>(m_matrix.rows()); }
@@ -51,8 +70,11 @@ public:
   /// the supernode update block, comes from a buffer this object keeps). False if A is not
   /// positive definite.
   bool factorize() noexcept;
-  /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized).
-  /// cholmod_solve2 with the solution and workspaces kept between calls.
+  /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized):
+  /// L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's supernodal L (dense
+  /// column-major blocks): per supernode the diagonal triangle, then the rows below it as one
+  /// dense product, in loops the compiler vectorises, with no BLAS call per supernode (most
+  /// supernodes of a network are small, where the call overhead dominated cholmod_solve2).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept;
 
   /// The assembled matrix (lower triangle stored).
@@ -62,6 +84,11 @@ public:
 
 private:
   void release() noexcept;
+  /// Index of entry (r, c) of the lower triangle in the matrix's values, or −1.
+  [[nodiscard]] int value_index(int r, int c) const noexcept;
+  /// The value slots of one cell's 24 x 24 entries from its current corners; false if one is
+  /// missing from the pattern.
+  bool bind_cell(const SpringNetwork& net, int cell) noexcept;
 
   std::vector<int> m_dof_of;
   Matrix m_matrix;
@@ -69,12 +96,16 @@ private:
   /// upper triangle).
   std::vector<int> m_entry;
   std::vector<int> m_diagonal; ///< value index of each dof's diagonal
+  std::vector<int> m_shadow_of;             ///< tear-ready: shadow dof of node n's axis i (3 n + i), or −1
+  std::vector<std::uint8_t> m_dof_in_use;   ///< per dof: 0 for a shadow no copy has taken yet
+  std::vector<int> m_node_at_point;         ///< tear-ready: the original node at each lattice point
+  std::vector<std::array<int, 8>> m_bound_cells; ///< the cell corners the entries were placed for
+  int m_bound_nodes = 0;
   cholmod_common_struct* m_common = nullptr;
   cholmod_factor_struct* m_factor = nullptr;
-  cholmod_dense_struct* m_rhs = nullptr;
-  cholmod_dense_struct* m_solution = nullptr;
-  cholmod_dense_struct* m_work_y = nullptr;
-  cholmod_dense_struct* m_work_e = nullptr;
+  SolvePrecision m_precision;
+  std::vector<float> m_factor_single;  ///< single-precision copy of L's values (single_precision)
+  std::vector<double> m_below;         ///< solve workspace: the rows below one supernode
   std::vector<double> m_update_buffer; ///< CHOLMOD's supernode update workspace (see factorize)
   bool m_factorized = false;
 };

@@ -5,15 +5,24 @@
 
 namespace kerf {
 
-NewtonStepper::NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations, double relative_tolerance)
-    : m_mode(mode), m_max_iterations(max_iterations), m_tolerance_ratio(relative_tolerance) {
+NewtonStepper::NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations, double relative_tolerance,
+                             bool tear_ready)
+    : m_mode(mode), m_max_iterations(max_iterations),
+      // Backward Euler's A = M/h² + … is well conditioned (the mass term), so its kept factor is
+      // read in single precision; the quasi-static K_T (regularised by 10⁻⁸ M only) is not.
+      m_system(mode == Mode::implicit_euler ? NetworkSystem::SolvePrecision::single_precision
+                                            : NetworkSystem::SolvePrecision::double_precision),
+      m_tolerance_ratio(relative_tolerance), m_tear_ready(tear_ready) {
   if (max_iterations < 1) throw std::invalid_argument("NewtonStepper: max_iterations must be >= 1");
   if (!(relative_tolerance > 0.0)) throw std::invalid_argument("NewtonStepper: the relative tolerance must be > 0");
   rebuild(net);
 }
 
 void NewtonStepper::rebuild(const SpringNetwork& net) {
-  m_system.rebuild(net);
+  // Tear-ready only on an untorn network (one still on its lattice); a rebuild after a split
+  // that did not fit is plain.
+  m_system.rebuild(net, m_tear_ready && LatticeForces(net).applies(net));
+  m_forces = LatticeForces(net);
   const int cap = net.node_capacity();
   m_x0.setZero(3, cap);
   m_v0.setZero(3, cap);
@@ -25,6 +34,12 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_factor_dt = -1.0;
   // Quasi-static regulariser: 1e-8 of the stiffness-to-mass scale k₁ / (cell mass / 8).
   m_static_regularisation = 1e-8 * net.stiffness.edge / (net.cell_mass / 8.0);
+}
+
+bool NewtonStepper::retopologise(const SpringNetwork& net) noexcept {
+  if (!m_system.bind_split_vertices(net)) return false;
+  m_factor_dt = -1.0;
+  return true;
 }
 
 bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
@@ -44,7 +59,7 @@ double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd&
       if (dof[static_cast<std::size_t>(3 * p + i)] >= 0)
         v(i, p) = m_mode == Mode::implicit_euler ? (x(i, p) - m_x0(i, p)) / dt : 0.0;
   // Quasi-static equilibrium has no damping: forces at zero velocity.
-  network_forces(net, x, m_mode == Mode::implicit_euler ? v : m_zero, m_f);
+  m_forces.evaluate(net, x, m_mode == Mode::implicit_euler ? v : m_zero, m_f);
   double norm = 0.0;
   for (int p = 0; p < net.node_count; ++p)
     for (int i = 0; i < 3; ++i)
@@ -74,7 +89,10 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
   // `fresh`: the kept factorisation was computed at the current iterate.
   bool fresh = false;
   if (m_mode == Mode::implicit_euler ? m_factor_dt != dt : m_factor_dt < 0.0) {
-    if (!refactor(net, x, dt)) return report;
+    if (!refactor(net, x, dt)) {
+      report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
+      return report;
+    }
     ++report.factorisations;
     fresh = true;
   }

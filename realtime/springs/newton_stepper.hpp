@@ -4,6 +4,7 @@
 // kept while it still converges (modified Newton) and refreshed when it does not, with a
 // backtracking line search on the residual so that a step far from the solution never diverges.
 
+#include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/network_system.hpp"
 #include "realtime/springs/spring_network.hpp"
 
@@ -29,10 +30,17 @@ public:
   /// Builds the system's pattern for `net` (allocates). `max_iterations` >= 1 per advance;
   /// `relative_tolerance` ε > 0: converged when the residual's max-norm is <= ε k₁ h [N] (the
   /// force of an edge spring stretched by ε of its length).
-  NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations, double relative_tolerance = 1e-9);
+  /// `tear_ready`: the system's pattern has room for vertex splits (NetworkSystem::rebuild), so
+  /// that `retopologise` can follow a tear without allocating.
+  NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations, double relative_tolerance = 1e-9,
+                bool tear_ready = false);
 
   /// Re-analyses after the network's cells, nodes or constraints changed (a tear). Allocates.
   void rebuild(const SpringNetwork& net);
+  /// After vertex splits on a tear-ready stepper: binds the copies to the kept pattern and marks
+  /// the factorisation stale (the next `advance` refactorises). Allocation-free; false if the
+  /// splits do not fit (then call `rebuild`).
+  bool retopologise(const SpringNetwork& net) noexcept;
 
   /// Advances (x, v) by dt [s]. On entry the free axes hold the state at tₙ and the fixed axes
   /// their prescribed end-of-step positions and velocities. The Jacobian A = M/h² + (1 + τ/h) K_T (implicit) or K_T + 10⁻⁸ (‖K‖/‖M‖) M (quasi-static; the
@@ -42,6 +50,11 @@ public:
   /// 1/32 of the Newton step) lowers the residual. Allocation-free.
   NewtonReport advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
 
+  /// The internal forces at the state the last `advance` returned (at its velocities, or at
+  /// zero velocity quasi-statically) [N], 3 x capacity: the residual's own evaluation, so the
+  /// caller need not recompute them.
+  [[nodiscard]] const Eigen::Matrix3Xd& forces() const { return m_f; }
+
 private:
   bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
   double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
@@ -49,7 +62,9 @@ private:
   Mode m_mode;
   int m_max_iterations;
   NetworkSystem m_system;
+  LatticeForces m_forces;
   double m_tolerance_ratio;
+  bool m_tear_ready = false;
   double m_factor_dt = -1.0;
   double m_static_regularisation = 0.0;
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;

@@ -129,6 +129,7 @@ void merge_springs(SpringNetwork& net) noexcept {
     ++count;
   }
   s.count = count;
+  ++net.topology;
 }
 
 Eigen::Matrix3d cell_deformation_gradient(const Eigen::Matrix<double, 3, 8>& corners, double h) {

@@ -63,6 +63,9 @@ struct SpringNetwork {
   std::vector<std::uint8_t> constraint;        ///< NodeConstraint bits
   int node_count = 0;
   SpringArrays springs;                        ///< from cell_nodes by merge_springs
+  /// Incremented by every merge_springs: a count that changes whenever the cells' corners may
+  /// have (LatticeForces uses it to know the network is still the one it was built for).
+  std::uint64_t topology = 0;
 
   [[nodiscard]] int cell_count() const { return static_cast<int>(cell_nodes.size()); }
   [[nodiscard]] int node_capacity() const { return static_cast<int>(rest.cols()); }

@@ -32,8 +32,12 @@ namespace {
 
 /// Safety factor on the computed explicit limit (the limit is for the linearised network).
 constexpr double explicit_safety = 0.9;
-/// Relative Newton tolerance of the implicit and quasi-static integrators (NewtonStepper).
-constexpr double newton_tolerance = 1e-7;
+/// Relative Newton tolerance of the implicit and quasi-static integrators (NewtonStepper): the
+/// residual's max-norm <= 10⁻⁵ k₁ h, the force of an edge spring stretched by 10⁻⁵ of its length
+/// (4·10⁻⁶ N on the clay scenes' 2.5 mm cells, against stylus forces of 0.1-10 N). At 10⁻⁷ (the
+/// previous value) the 1 ms implicit step took two or three kept-factor iterations where one
+/// now suffices (experiments/benchmarks/bench_springs.cpp; docs/spring-network.md §2).
+constexpr double newton_tolerance = 1e-5;
 /// Sub-steps beyond this in one sample are reported as over budget.
 constexpr int max_substeps = 100000;
 
@@ -127,6 +131,15 @@ SpringNetworkModel::SpringNetworkModel(const TetMesh& mesh, SpringNetworkSetup s
   const SpringNetworkSetup& s = m_setup;
   if (s.styluses.empty() || s.styluses.size() > 2)
     throw std::invalid_argument("springs: needs one or two styluses, got " + std::to_string(s.styluses.size()));
+  for (const SpringStylus& t : s.styluses)
+    if (t.blade) {
+      if (s.styluses.size() != 1) throw std::invalid_argument("springs: a blade is taken alone (one tool)");
+      const SpringBladeEdge& b = *t.blade;
+      if (!(b.length > 0.0)) throw std::invalid_argument("springs: the blade's edge length must be > 0 m");
+      if (std::abs(b.edge_direction.norm() - 1.0) > 1e-9 || std::abs(b.cutting_direction.norm() - 1.0) > 1e-9 ||
+          std::abs(b.edge_direction.dot(b.cutting_direction)) > 1e-9)
+        throw std::invalid_argument("springs: the blade's edge and cutting directions must be orthogonal unit vectors");
+    }
   if (s.cells < 1) throw std::invalid_argument("springs: cells per block side must be >= 1, got " + std::to_string(s.cells));
   if (!(s.cell_size >= 0.0)) throw std::invalid_argument("springs: cell size must be >= 0 (0: automatic)");
   if (!(s.damping >= 0.0)) throw std::invalid_argument("springs: damping must be >= 0 Pa s");
@@ -152,7 +165,11 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   double spread = 0.0;
   for (const auto& a : contact)
     for (const auto& b : contact) spread = std::max(spread, (a - b).norm());
-  const double h = s.cell_size > 0.0 ? s.cell_size : std::max(extent.minCoeff(), 2.0 * spread) / s.cells;
+  // A blade's reach: its edge's span within the body's box.
+  double reach = 2.0 * spread;
+  for (const SpringStylus& t : s.styluses)
+    if (t.blade) reach = std::max(reach, std::min(t.blade->length, extent.dot(t.blade->edge_direction.cwiseAbs())));
+  const double h = s.cell_size > 0.0 ? s.cell_size : std::max(extent.minCoeff(), reach) / s.cells;
   const double side = h * s.cells;
   NetworkBlock block;
   block.cell_size = h;
@@ -198,8 +215,34 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
 
   // 4. Nodes under each stylus tip are attached to it.
   m_attached_to.assign(static_cast<std::size_t>(net.node_capacity()), -1);
+  m_gap.assign(static_cast<std::size_t>(net.node_capacity()), 0.0);
   for (int t = 0; t < static_cast<int>(s.styluses.size()); ++t) {
     const SpringStylus& stylus = s.styluses[static_cast<std::size_t>(t)];
+    if (stylus.blade) {
+      // The nodes under the edge: within its span and h/2 of its plane, ahead of it along c.
+      const Eigen::Vector3d& e = stylus.blade->edge_direction;
+      const Eigen::Vector3d& c = stylus.blade->cutting_direction;
+      const Eigen::Vector3d lateral = c.cross(e);
+      const double tolerance = 1e-9 * h;
+      std::vector<int> under;
+      double first = INFINITY;
+      for (int p = 0; p < net.node_count; ++p) {
+        const Eigen::Vector3d u = net.rest.col(p) - stylus.start;
+        if (std::abs(u.dot(e)) <= 0.5 * stylus.blade->length + tolerance && std::abs(u.dot(lateral)) <= 0.5 * h + tolerance &&
+            u.dot(c) >= -tolerance) {
+          under.push_back(p);
+          first = std::min(first, u.dot(c));
+        }
+      }
+      // The first layer the edge meets.
+      for (int p : under)
+        if (const double gap = (net.rest.col(p) - stylus.start).dot(c); gap <= first + 0.5 * h) {
+          m_attached_to[static_cast<std::size_t>(p)] = t;
+          m_gap[static_cast<std::size_t>(p)] = std::max(gap, 0.0);
+        }
+      if (under.empty()) throw std::invalid_argument("springs: no network node lies under the blade's edge");
+      continue;
+    }
     int nearest = -1;
     double nearest_distance = INFINITY;
     int count = 0;
@@ -222,6 +265,7 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   m_initial = std::move(net);
   m_omega_max = highest_angular_frequency(m_initial);
   m_stability_limit = symplectic_euler_stability_limit(m_omega_max, m_initial.damping_time);
+  m_lattice = LatticeForces(m_initial);
   m_gershgorin_work.assign(static_cast<std::size_t>(m_initial.node_capacity()), 0.0);
   m_gershgorin_rest = gershgorin_frequency_bound(m_initial, m_initial.rest, m_gershgorin_work);
 }
@@ -236,7 +280,6 @@ void SpringNetworkModel::reset() {
   m_x = m_net.rest;
   m_v.setZero(3, cap);
   m_f.setZero(3, cap);
-  m_zero.setZero(3, cap);
   m_last_tool.assign(m_setup.styluses.size(), Eigen::Vector3d::Zero());
   m_started = false;
   m_tears = 0;
@@ -246,12 +289,10 @@ void SpringNetworkModel::reset() {
   m_piece_label.assign(static_cast<std::size_t>(m_net.cell_count()), 0);
   m_pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
   m_newton.reset();
-  // Newton tolerance: the force of an edge spring stretched by 10⁻⁷ of its length (4·10⁻⁸ N on
-  // the clay scenes' 2.5 mm cells), far below what a haptic device renders.
   if (m_setup.integrator == SpringIntegrator::implicit_euler)
-    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::implicit_euler, 8, newton_tolerance);
+    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::implicit_euler, 8, newton_tolerance, m_setup.tearing);
   else if (m_setup.integrator == SpringIntegrator::quasi_static)
-    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::quasi_static, 30, newton_tolerance);
+    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::quasi_static, 30, newton_tolerance, m_setup.tearing);
   m_tearing = m_setup.tearing ? std::make_unique<VertexTearing>(m_net, m_setup.tensile_limit) : nullptr;
 }
 
@@ -272,7 +313,17 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
       if (t < 0) continue;
       const Eigen::Vector3d& from = m_last_tool[static_cast<std::size_t>(t)];
       const Eigen::Vector3d& to = tools[static_cast<std::size_t>(t)].position;
-      const Eigen::Vector3d target = m_net.rest.col(p) + (from + s * (to - from)) - m_setup.styluses[static_cast<std::size_t>(t)].start;
+      const SpringStylus& tool = m_setup.styluses[static_cast<std::size_t>(t)];
+      if (tool.blade) {
+        // x = X + c max(0, (p − p₀)·c − g): the node stays until the edge reaches it.
+        const Eigen::Vector3d& c = tool.blade->cutting_direction;
+        const double gap = m_gap[static_cast<std::size_t>(p)];
+        const auto push = [&](const Eigen::Vector3d& at) { return std::max(0.0, (at - tool.start).dot(c) - gap); };
+        m_x.col(p) = m_net.rest.col(p) + push(from + s * (to - from)) * c;
+        m_v.col(p) = (push(to) - push(from)) / dt * c;
+        continue;
+      }
+      const Eigen::Vector3d target = m_net.rest.col(p) + (from + s * (to - from)) - tool.start;
       m_v.col(p) = (to - from) / dt;
       m_x.col(p) = target;
     }
@@ -290,7 +341,7 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
     const double h = dt / substeps;
     for (int k = 1; k <= substeps; ++k) {
       place_attached(static_cast<double>(k) / substeps);
-      symplectic_euler_step(m_net, m_x, m_v, h, m_f);
+      symplectic_euler_step(m_net, m_x, m_v, h, m_lattice, m_f);
     }
     m_last_substeps = substeps;
   } else {
@@ -302,8 +353,12 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
   }
   for (int t = 0; t < n_tools; ++t) m_last_tool[static_cast<std::size_t>(t)] = tools[static_cast<std::size_t>(t)].position;
 
-  // The force on each stylus: the sum of the internal forces on its attached nodes.
-  network_forces(m_net, m_x, m_setup.integrator == SpringIntegrator::quasi_static ? m_zero : m_v, m_f);
+  // The force on each stylus: the sum of the internal forces on its attached nodes (at the end
+  // of the sample; the Newton stepper's last residual evaluation already holds them).
+  if (m_newton)
+    m_f.leftCols(m_net.node_count) = m_newton->forces().leftCols(m_net.node_count);
+  else
+    m_lattice.evaluate(m_net, m_x, m_v, m_f);
   bool finite = m_x.leftCols(m_net.node_count).allFinite();
   for (int t = 0; t < n_tools; ++t) forces[static_cast<std::size_t>(t)] = ForceSample{Eigen::Vector3d::Zero(), InteractionMode::deformation_1, 0.0, over_budget};
   for (int p = 0; p < m_net.node_count; ++p)
@@ -311,7 +366,9 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
 
   if (m_tearing && finite && m_tearing->tear(m_net, m_x, m_v, m_excluded)) {
     ++m_tears;
-    if (m_newton) m_newton->rebuild(m_net);
+    // The tear-ready pattern takes the split without a new analysis (allocation-free); a split
+    // it cannot take (none is expected: each vertex splits once) re-analyses, which allocates.
+    if (m_newton && !m_newton->retopologise(m_net)) m_newton->rebuild(m_net);
     const int pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
     if (pieces > m_pieces)
       for (ForceSample& f : forces) f.mode = InteractionMode::rupture;

@@ -36,10 +36,22 @@ struct SpringSupport {
   bool sliding = false;
 };
 
-/// A stylus: its tip centre at the first sample [m] and tip radius [m].
+/// A blade's edge pressing the network: the deformation phase of a cutting scene (paper 001's
+/// deformation before rupture), the edge a straight segment of `length` [m] along the unit
+/// `edge_direction`, moving along the unit `cutting_direction` (orthogonal to it). The network
+/// does not cut: past the rupture point its response is the uncut body's.
+struct SpringBladeEdge {
+  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ();
+  double length = 0.0;
+};
+
+/// A tool: a stylus, its tip centre at the first sample [m] and tip radius [m]; or, with
+/// `blade`, a blade whose edge midpoint is at `start` at the first sample (radius unused).
 struct SpringStylus {
   Eigen::Vector3d start = Eigen::Vector3d::Zero();
   double radius = 0.0;
+  std::optional<SpringBladeEdge> blade = std::nullopt;
 };
 
 /// Everything the model is built from (SI units).
@@ -74,6 +86,12 @@ struct SpringNetworkSetup {
 /// 4. styluses: nodes within the grasp radius (r + h/2 unless given) of a tip centre (at least the
 ///    nearest one) are attached to it
 ///    and move with it (paper 000 §2.1: "the vertices at the stylus tip is fixed to the stylus").
+///    A blade (one tool alone): the nodes under its edge — within the edge's span, within h/2 of
+///    the plane of the edge and the cutting direction, in the first layer the edge meets (gap g
+///    along the cutting direction c within h/2 of the smallest) — are attached; each stays put
+///    until the edge reaches it and is then pushed along c: x = X + c max(0, (p − p₀)·c − g).
+///    For a blade the block side covers the edge's span in the body, h = max(smallest extent,
+///    that span) / N.
 /// `step`: attached nodes follow the stylus; the network is advanced by dt with the integrator;
 /// the force on each stylus is the sum of the internal forces on its attached nodes; mode is
 /// deformation-1, and rupture on the sample in which a tear separates the network into more
@@ -108,8 +126,9 @@ private:
   CellIdentification m_identification;
   SpringNetwork m_initial, m_net;
   std::vector<int> m_attached_to;        ///< per node: stylus index or -1
+  std::vector<double> m_gap;             ///< per node attached to a blade: its gap g [m]
   std::vector<std::uint8_t> m_excluded;  ///< per node: not torn (attached)
-  Eigen::Matrix3Xd m_x, m_v, m_f, m_zero;
+  Eigen::Matrix3Xd m_x, m_v, m_f;
   std::vector<Eigen::Vector3d> m_last_tool;
   bool m_started = false;
   double m_omega_max = 0.0;
@@ -120,6 +139,7 @@ private:
   int m_tears = 0;
   long m_factorisations = 0;
   int m_pieces = 1;
+  LatticeForces m_lattice;               ///< the explicit integrator's force loops
   std::unique_ptr<NewtonStepper> m_newton;
   std::unique_ptr<VertexTearing> m_tearing;
   std::vector<int> m_piece_parent, m_piece_label;

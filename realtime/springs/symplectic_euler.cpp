@@ -47,20 +47,28 @@ double symplectic_euler_stability_limit(double omega_max, double damping_time) {
 
 double gershgorin_frequency_bound(const SpringNetwork& net, const Eigen::Matrix3Xd& x, std::vector<double>& work) noexcept {
   std::fill(work.begin(), work.begin() + net.node_count, 0.0);
+  // Springs: the merged flat arrays (a merged spring's constant is the sum of its cells' ones,
+  // and the row sums are linear in k).
+  const SpringArrays& s = net.springs;
+  for (int i = 0; i < s.count; ++i) {
+    const int a = s.a[static_cast<std::size_t>(i)], b = s.b[static_cast<std::size_t>(i)];
+    const double l = (x.col(b) - x.col(a)).norm();
+    const double L = s.rest[static_cast<std::size_t>(i)];
+    const double row = 2.0 * s.k[static_cast<std::size_t>(i)] * std::max(1.0, l > 0.0 ? std::abs(1.0 - L / l) : 1e6);
+    work[static_cast<std::size_t>(a)] += row;
+    work[static_cast<std::size_t>(b)] += row;
+  }
   const double h = net.block.cell_size;
   const double kappa = net.stiffness.volume_modulus;
-  Eigen::Matrix<double, 3, 8> xc;
-  for (const auto& nodes : net.cell_nodes) {
-    for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
-    for (const CellSpring& sp : cell_springs) {
-      const double l = (xc.col(sp.b) - xc.col(sp.a)).norm();
-      const double L = net.rest_length(sp.type);
-      const double row = 2.0 * net.spring_constant(sp.type) * std::max(1.0, l > 0.0 ? std::abs(1.0 - L / l) : 1e6);
-      work[static_cast<std::size_t>(nodes[static_cast<std::size_t>(sp.a)])] += row;
-      work[static_cast<std::size_t>(nodes[static_cast<std::size_t>(sp.b)])] += row;
-    }
-    if (kappa > 0.0) {
-      const Eigen::Matrix3d F = cell_deformation_gradient(xc, h);
+  if (kappa > 0.0) {
+    const double c = 1.0 / (4.0 * h);
+    for (const auto& nodes : net.cell_nodes) {
+      // F = Σ_a x_a ⊗ g_a, g_a = s_a / (4h), column by column.
+      Eigen::Matrix3d F = Eigen::Matrix3d::Zero();
+      for (int a = 0; a < 8; ++a) {
+        const auto xa = x.col(nodes[static_cast<std::size_t>(a)]);
+        for (int i = 0; i < 3; ++i) F.col(i) += ((a >> i) & 1 ? c : -c) * xa;
+      }
       Eigen::Matrix3d cof;
       cof.col(0) = F.col(1).cross(F.col(2));
       cof.col(1) = F.col(2).cross(F.col(0));
@@ -68,7 +76,7 @@ double gershgorin_frequency_bound(const SpringNetwork& net, const Eigen::Matrix3
       double norms[8], total = 0.0;
       for (int a = 0; a < 8; ++a) {
         const Eigen::Vector3d s_a(2.0 * (a & 1) - 1.0, 2.0 * ((a >> 1) & 1) - 1.0, 2.0 * ((a >> 2) & 1) - 1.0);
-        norms[a] = (cof * s_a / (4.0 * h)).norm();
+        norms[a] = c * (cof * s_a).norm(); // |∇_a J| = |cof(F) g_a|
         total += norms[a];
       }
       for (int a = 0; a < 8; ++a) work[static_cast<std::size_t>(nodes[static_cast<std::size_t>(a)])] += kappa * h * h * h * norms[a] * total;
@@ -81,9 +89,10 @@ double gershgorin_frequency_bound(const SpringNetwork& net, const Eigen::Matrix3
   return bound;
 }
 
-double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
-                             Eigen::Matrix3Xd& f) noexcept {
-  const double energy = network_forces(net, x, v, f);
+namespace {
+/// v ← v + h f / m, then x ← x + h v, on the free axes.
+void symplectic_euler_update(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
+                             const Eigen::Matrix3Xd& f) noexcept {
   for (int p = 0; p < net.node_count; ++p) {
     const std::uint8_t fixed = net.constraint[static_cast<std::size_t>(p)];
     const double inv_m = 1.0 / net.mass[static_cast<std::size_t>(p)];
@@ -94,6 +103,20 @@ double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eige
       x(i, p) += h * v(i, p);
     }
   }
+}
+} // namespace
+
+double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
+                             Eigen::Matrix3Xd& f) noexcept {
+  const double energy = network_forces(net, x, v, f);
+  symplectic_euler_update(net, x, v, h, f);
+  return energy;
+}
+
+double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
+                             LatticeForces& forces, Eigen::Matrix3Xd& f) noexcept {
+  const double energy = forces.evaluate(net, x, v, f);
+  symplectic_euler_update(net, x, v, h, f);
   return energy;
 }
 

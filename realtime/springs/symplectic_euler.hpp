@@ -2,6 +2,7 @@
 // Symplectic (semi-implicit) Euler for the spring network, with the stability limit it computes
 // from the network itself.
 
+#include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/spring_network.hpp"
 
 #include <vector>
@@ -33,5 +34,9 @@ double gershgorin_frequency_bound(const SpringNetwork& net, const Eigen::Matrix3
 /// Returns the elastic energy at the start of the step [J]. Allocation-free.
 double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
                              Eigen::Matrix3Xd& f) noexcept;
+/// The same step with the forces from `forces` (the vectorised lattice loops while the network
+/// is untorn, network_forces after a tear). Allocation-free.
+double symplectic_euler_step(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double h,
+                             LatticeForces& forces, Eigen::Matrix3Xd& f) noexcept;
 
 } // namespace kerf

@@ -84,7 +84,25 @@ TornTetMesh split_tet_mesh(const TetMesh& mesh, const SpringNetwork& net) {
   std::vector<Eigen::Vector3d> nodes;
   std::vector<Eigen::Vector4i> tets;
   const double quantum = 1e-9 * h;
-  const auto add_tet = [&](Tet t, int piece, int host) {
+  // The host of a node of `piece`: a kept cell of that piece containing the point (a point on a
+  // cell face, edge or corner lies in up to 8 cells: the first of the piece), or −1.
+  const auto host_of = [&](const Eigen::Vector3d& p, int piece) {
+    const Eigen::Vector3d q = grid(p);
+    const Eigen::Vector3i base = q.array().floor().cast<int>();
+    for (int k = 0; k < 8; ++k) {
+      Eigen::Vector3i g = base;
+      bool valid = true;
+      for (int i = 0; i < 3; ++i)
+        if ((k >> i) & 1) {
+          if (q[i] - base[i] < 1e-9) g[i] -= 1;
+          else valid = false;
+        }
+      if (!valid) continue;
+      if (const int c = net.cell_at_index(g); c >= 0 && label[static_cast<std::size_t>(c)] == piece) return c;
+    }
+    return -1;
+  };
+  const auto add_tet = [&](Tet t, int piece) {
     if (signed_volume(t) < 0.0) std::swap(t[2], t[3]);
     if (!(signed_volume(t) > 0.0)) return;
     Eigen::Vector4i ids;
@@ -94,7 +112,7 @@ TornTetMesh split_tet_mesh(const TetMesh& mesh, const SpringNetwork& net) {
       auto [it, inserted] = node_of.emplace(key, static_cast<int>(nodes.size()));
       if (inserted) {
         nodes.push_back(p);
-        torn.host_cell.push_back(host);
+        torn.host_cell.push_back(host_of(p, piece));
       }
       ids[k] = it->second;
     }
@@ -120,9 +138,8 @@ TornTetMesh split_tet_mesh(const TetMesh& mesh, const SpringNetwork& net) {
             if (first_piece < 0) first_piece = piece;
             else mixed = mixed || piece != first_piece;
           }
-    const Eigen::Vector3d centroid = (tet[0] + tet[1] + tet[2] + tet[3]) / 4.0;
     if (!mixed) {
-      add_tet(tet, first_piece, cell_of(centroid));
+      add_tet(tet, first_piece);
       continue;
     }
     parts.assign(1, tet);
@@ -140,7 +157,7 @@ TornTetMesh split_tet_mesh(const TetMesh& mesh, const SpringNetwork& net) {
       }
     for (const Tet& part : parts) {
       const int c = cell_of((part[0] + part[1] + part[2] + part[3]) / 4.0);
-      add_tet(part, c >= 0 ? label[static_cast<std::size_t>(c)] : first_piece, c);
+      add_tet(part, c >= 0 ? label[static_cast<std::size_t>(c)] : first_piece);
     }
   }
   torn.mesh.nodes.resize(static_cast<Eigen::Index>(nodes.size()), 3);

@@ -13,7 +13,7 @@ namespace kerf {
 /// A fine mesh split along the network's pieces.
 struct TornTetMesh {
   TetMesh mesh;                  ///< rest positions; nodes duplicated per piece; volume group "body"
-  std::vector<int> host_cell;    ///< per node: the network cell it is embedded in (−1 outside)
+  std::vector<int> host_cell;    ///< per node: a cell of its piece that contains it (−1 outside the network)
   std::vector<int> piece;        ///< per tetrahedron: the network piece label it belongs to
 };
 

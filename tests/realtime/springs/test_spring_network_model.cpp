@@ -63,5 +63,43 @@ TEST(SpringNetworkModel, PullForceFromEachIntegrator) {
   EXPECT_NEAR(final_force[2], final_force[0], 0.10 * std::abs(final_force[0]));
 }
 
+TEST(SpringNetworkModel, BladePressesOnlyOnceItsEdgeArrives) {
+  // The deformation phase of a cutting scene (potato_rect_cut's geometry: a bonded 40 x 20 x 15 mm
+  // prism, a 30 mm edge across it at x = 20 mm, starting 1 mm above the top face, pressed down).
+  // Independent expectations: no force before the edge reaches the surface (the gap); after it,
+  // the body pushes the blade back (+z) with no net x or y force (the set-up is symmetric about
+  // x = 20 mm and y = 0), the static force grows with the depth, and returns to zero when the
+  // blade is withdrawn to the surface (elastic, quasi-static).
+  const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.04, 0.01, 0.015}, 16, 8, 6);
+  SpringNetworkSetup s = test::clay_pull_setup(SpringIntegrator::quasi_static);
+  s.youngs_modulus = 3e6;
+  s.styluses = {{Eigen::Vector3d(0.02, 0.0, 0.016), 0.0, SpringBladeEdge{Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ(), 0.03}}};
+  SpringNetworkModel model(mesh, s);
+  // The block covers the edge's 20 mm span in the body: h = 20 mm / 8; the first layer under the
+  // edge is the top face's line x = 20 mm, y in [-10, 10] mm: 9 nodes.
+  EXPECT_NEAR(model.network().block.cell_size, 2.5e-3, 1e-15);
+  EXPECT_EQ(model.attached_nodes(0), 9);
+  std::array<ToolState, 1> tool;
+  std::array<ForceSample, 1> force;
+  double last = 0.0;
+  for (const double depth : {-0.5e-3, 0.0, 0.25e-3, 0.5e-3, 1.0e-3, 1.5e-3}) {
+    tool[0].position = Eigen::Vector3d(0.02, 0.0, 0.015 - depth);
+    model.step(tool, 1e-3, force);
+    ASSERT_FALSE(force[0].over_budget) << depth;
+    if (depth <= 0.0) {
+      EXPECT_LT(force[0].force.norm(), 1e-9) << depth; // the rest state's round-off (4.6e-13 N)
+      continue;
+    }
+    EXPECT_GT(force[0].force.z(), last) << depth;
+    EXPECT_LT(std::abs(force[0].force.x()), 1e-6 * force[0].force.z()) << depth;
+    EXPECT_LT(std::abs(force[0].force.y()), 1e-6 * force[0].force.z()) << depth;
+    last = force[0].force.z();
+  }
+  tool[0].position = Eigen::Vector3d(0.02, 0.0, 0.015);
+  model.step(tool, 1e-3, force);
+  // Zero to the Newton tolerance (10⁻⁵ k₁ h = 2.3e-5 N per node, 9 attached nodes).
+  EXPECT_LT(force[0].force.norm(), 9 * 2.3e-5);
+}
+
 } // namespace
 } // namespace kerf

@@ -1,0 +1,239 @@
+#include "realtime/springs/lattice_forces.hpp"
+
+#include "realtime/springs/vector_clones.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kerf {
+
+namespace {
+
+/// The 13 lattice directions of the 28 cell springs, each with its first non-zero component
+/// positive: 3 edges, 6 face diagonals, 4 body diagonals.
+constexpr std::array<std::array<int, 3>, 13> directions{{{1, 0, 0},  {0, 1, 0},  {0, 0, 1},  {1, 1, 0},  {1, -1, 0},
+                                                         {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}, {1, 1, 1},
+                                                         {1, 1, -1}, {1, -1, 1}, {1, -1, -1}}};
+
+/// Local corner a's sign along axis i, s_a[i] ∈ {−1, +1} (corner a = bx + 2 by + 4 bz).
+constexpr double corner_sign(int a, int i) { return ((a >> i) & 1) ? 1.0 : -1.0; }
+
+/// The springs of one lattice direction, from lattice points p in [begin, end) to p + o: adds
+/// each spring's force on its start point to F and stores it in G (the end point takes −G).
+/// Returns their elastic energy [J].
+KERF_VECTOR_CLONES
+double direction_springs(int begin, int end, int o, double rest, double tau, double tiny, const double* __restrict k,
+                         const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
+                         const double* __restrict VX, const double* __restrict VY, const double* __restrict VZ,
+                         double* __restrict FX, double* __restrict FY, double* __restrict FZ, double* __restrict GX,
+                         double* __restrict GY, double* __restrict GZ) {
+  double energy = 0.0;
+#pragma omp simd reduction(+ : energy)
+  for (int p = begin; p < end; ++p) {
+    const int q = p + o;
+    const double ex = X[q] - X[p], ey = Y[q] - Y[p], ez = Z[q] - Z[p];
+    const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double inv_l = l > tiny ? 1.0 / l : 0.0; // coincident ends: no direction, no force
+    const double stretch = l - rest;
+    const double rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
+    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
+    const double scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
+    const double gx = scale * ex, gy = scale * ey, gz = scale * ez;
+    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
+    GX[p] = gx, GY[p] = gy, GZ[p] = gz;
+    energy += inv_l > 0.0 ? 0.5 * k[p] * stretch * stretch : 0.0;
+  }
+  return energy;
+}
+
+/// F[p + o] −= G[p] for p in [begin, end): the end points' share of one direction's springs.
+KERF_VECTOR_CLONES
+void direction_ends(int begin, int end, int o, const double* __restrict GX, const double* __restrict GY,
+                    const double* __restrict GZ, double* __restrict FX, double* __restrict FY, double* __restrict FZ) {
+#pragma omp simd
+  for (int p = begin; p < end; ++p) {
+    FX[p + o] -= GX[p];
+    FY[p + o] -= GY[p];
+    FZ[p + o] -= GZ[p];
+  }
+}
+
+/// The volume term of the cells starting at lattice points [0, end) (mask 1 where a cell
+/// exists): with c = 1/(4h) and the corner offsets o_a,
+///   F = c Σ_a x_a ⊗ s_a,  Ḟ = c Σ_a v_a ⊗ s_a,  J = det F,  J̇ = Σ_i cof(F)_i · Ḟ_i,
+///   P = κ V₀ ((J − 1) + τ J̇),  Q_i = P c cof(F)_i (column i of the cofactor),
+/// so that the force on corner a is −Σ_i s_a[i] Q_i (f_a = −P cof(F) g_a, g_a = c s_a).
+/// Q is 9 planes (column i, row r at plane 3 i + r) of `stride` entries, written at pad + p.
+/// Returns the cells' energy Σ ½ κ V₀ (J − 1)² [J].
+KERF_VECTOR_CLONES
+double cell_volumes(int end, const int* corner, double c, double kappa_v0, double tau, const double* __restrict mask,
+                    const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
+                    const double* __restrict VX, const double* __restrict VY, const double* __restrict VZ,
+                    double* __restrict Q, int stride, int pad) {
+  const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
+  double energy = 0.0;
+  // Column i of c Σ_a w_a ⊗ s_a from one coordinate plane W (the row), p the cell's lower corner.
+  const auto column = [&](const double* __restrict W, int p, int i) {
+    switch (i) {
+    case 0: return c * ((W[p + o1] - W[p]) + (W[p + o3] - W[p + o2]) + (W[p + o5] - W[p + o4]) + (W[p + o7] - W[p + o6]));
+    case 1: return c * ((W[p + o2] - W[p]) + (W[p + o3] - W[p + o1]) + (W[p + o6] - W[p + o4]) + (W[p + o7] - W[p + o5]));
+    default: return c * ((W[p + o4] - W[p]) + (W[p + o5] - W[p + o1]) + (W[p + o6] - W[p + o2]) + (W[p + o7] - W[p + o3]));
+    }
+  };
+#pragma omp simd reduction(+ : energy)
+  for (int p = 0; p < end; ++p) {
+    // F columns a (i = 0), b (1), d (2); rows x, y, z.
+    const double ax = column(X, p, 0), ay = column(Y, p, 0), az = column(Z, p, 0);
+    const double bx = column(X, p, 1), by = column(Y, p, 1), bz = column(Z, p, 1);
+    const double dx = column(X, p, 2), dy = column(Y, p, 2), dz = column(Z, p, 2);
+    // cof(F) = [b × d, d × a, a × b]
+    const double c0x = by * dz - bz * dy, c0y = bz * dx - bx * dz, c0z = bx * dy - by * dx;
+    const double c1x = dy * az - dz * ay, c1y = dz * ax - dx * az, c1z = dx * ay - dy * ax;
+    const double c2x = ay * bz - az * by, c2y = az * bx - ax * bz, c2z = ax * by - ay * bx;
+    const double J = ax * c0x + ay * c0y + az * c0z;
+    const double J_rate = c0x * column(VX, p, 0) + c0y * column(VY, p, 0) + c0z * column(VZ, p, 0) +
+                          c1x * column(VX, p, 1) + c1y * column(VY, p, 1) + c1z * column(VZ, p, 1) +
+                          c2x * column(VX, p, 2) + c2y * column(VY, p, 2) + c2z * column(VZ, p, 2);
+    // P c = κ V₀ ((J − 1) + τ J̇) c, masked to the cells that exist
+    const double pc = mask[p] * kappa_v0 * ((J - 1.0) + tau * J_rate) * c;
+    const int at = pad + p;
+    Q[at] = pc * c0x, Q[stride + at] = pc * c0y, Q[2 * stride + at] = pc * c0z;
+    Q[3 * stride + at] = pc * c1x, Q[4 * stride + at] = pc * c1y, Q[5 * stride + at] = pc * c1z;
+    Q[6 * stride + at] = pc * c2x, Q[7 * stride + at] = pc * c2y, Q[8 * stride + at] = pc * c2z;
+    energy += 0.5 * kappa_v0 * mask[p] * (J - 1.0) * (J - 1.0);
+  }
+  return energy;
+}
+
+/// F_r[q] −= Σ_a Σ_i s_a[i] Q_{i r}[pad + q − o_a] for lattice points q in [0, points): each
+/// point collects the volume forces of the (up to 8) cells it is a corner of.
+KERF_VECTOR_CLONES
+void cell_volume_forces(int points, const int* corner, const double* __restrict Q, int stride, int pad,
+                        double* __restrict FX, double* __restrict FY, double* __restrict FZ) {
+  double* F[3] = {FX, FY, FZ};
+  for (int r = 0; r < 3; ++r) {
+    const double* __restrict Q0 = Q + r * stride + pad;
+    const double* __restrict Q1 = Q + (3 + r) * stride + pad;
+    const double* __restrict Q2 = Q + (6 + r) * stride + pad;
+    double* __restrict Fr = F[r];
+    for (int a = 0; a < 8; ++a) {
+      const int o = corner[a];
+      const double s0 = corner_sign(a, 0), s1 = corner_sign(a, 1), s2 = corner_sign(a, 2);
+#pragma omp simd
+      for (int q = 0; q < points; ++q) Fr[q] -= s0 * Q0[q - o] + s1 * Q1[q - o] + s2 * Q2[q - o];
+    }
+  }
+}
+
+} // namespace
+
+LatticeForces::LatticeForces(const SpringNetwork& net) {
+  const Eigen::Vector3i n = net.block.cells;
+  const int px = n.x() + 1, py = n.y() + 1, pz = n.z() + 1;
+  m_points = px * py * pz;
+  const auto linear = [px, py](int i, int j, int k) { return i + px * (j + py * k); };
+  for (std::size_t d = 0; d < directions.size(); ++d) {
+    const auto& e = directions[d];
+    m_offset[d] = linear(e[0], e[1], e[2]);
+    m_type[d] = std::abs(e[0]) + std::abs(e[1]) + std::abs(e[2]);
+  }
+  for (int a = 0; a < 8; ++a) m_corner[static_cast<std::size_t>(a)] = linear(a & 1, (a >> 1) & 1, (a >> 2) & 1);
+  m_pad = m_corner[7];
+
+  // Each node's lattice point; a network with two nodes on one point (a split vertex) or a cell
+  // whose corners are not the lattice's is not a lattice: `applies` then stays false.
+  const double h = net.block.cell_size;
+  m_slot.assign(static_cast<std::size_t>(net.node_capacity()), -1);
+  std::vector<int> node_at(static_cast<std::size_t>(m_points), -1);
+  for (int p = 0; p < net.node_count; ++p) {
+    const Eigen::Vector3i g = ((net.rest.col(p) - net.block.origin) / h).array().round().cast<int>();
+    if ((g.array() < 0).any() || g.x() >= px || g.y() >= py || g.z() >= pz) return;
+    const int s = linear(g.x(), g.y(), g.z());
+    if (node_at[static_cast<std::size_t>(s)] >= 0) return;
+    node_at[static_cast<std::size_t>(s)] = p;
+    m_slot[static_cast<std::size_t>(p)] = s;
+  }
+  m_k.assign(13 * static_cast<std::size_t>(m_points), 0.0);
+  m_cell.assign(static_cast<std::size_t>(m_points), 0.0);
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const Eigen::Vector3i& g = net.cell_index[static_cast<std::size_t>(c)];
+    const int base = linear(g.x(), g.y(), g.z());
+    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(c)];
+    for (int a = 0; a < 8; ++a)
+      if (m_slot[static_cast<std::size_t>(nodes[static_cast<std::size_t>(a)])] != base + m_corner[static_cast<std::size_t>(a)]) return;
+    m_cell[static_cast<std::size_t>(base)] = 1.0;
+    for (const CellSpring& s : cell_springs) {
+      // The spring from corner a to corner b as a lattice direction from one of its ends.
+      std::array<int, 3> e{((s.b & 1) - (s.a & 1)), ((s.b >> 1) & 1) - ((s.a >> 1) & 1), ((s.b >> 2) & 1) - ((s.a >> 2) & 1)};
+      int start = s.a;
+      const int first = e[0] != 0 ? e[0] : e[1] != 0 ? e[1] : e[2];
+      if (first < 0) {
+        for (int& component : e) component = -component;
+        start = s.b;
+      }
+      const auto d = static_cast<std::size_t>(std::find(directions.begin(), directions.end(), e) - directions.begin());
+      m_k[d * static_cast<std::size_t>(m_points) + static_cast<std::size_t>(base + m_corner[static_cast<std::size_t>(start)])] +=
+          net.spring_constant(s.type);
+    }
+  }
+  m_x.assign(3 * static_cast<std::size_t>(m_points), 0.0);
+  m_v.assign(3 * static_cast<std::size_t>(m_points), 0.0);
+  m_f.assign(3 * static_cast<std::size_t>(m_points), 0.0);
+  m_g.assign(3 * static_cast<std::size_t>(m_points), 0.0);
+  m_q.assign(9 * static_cast<std::size_t>(m_pad + m_points), 0.0);
+  // Lattice points without a node keep their rest position (their springs have k = 0).
+  for (int k = 0; k < pz; ++k)
+    for (int j = 0; j < py; ++j)
+      for (int i = 0; i < px; ++i)
+        for (int r = 0; r < 3; ++r)
+          m_x[static_cast<std::size_t>(r * m_points + linear(i, j, k))] = net.block.origin[r] + h * Eigen::Vector3i(i, j, k)[r];
+  m_node_count = net.node_count;
+  m_topology = net.topology;
+}
+
+bool LatticeForces::applies(const SpringNetwork& net) const noexcept {
+  return m_node_count >= 0 && net.node_count == m_node_count && net.topology == m_topology;
+}
+
+double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
+                               Eigen::Matrix3Xd& f) noexcept {
+  if (!applies(net)) return network_forces(net, x, v, f);
+  const int P = m_points;
+  double* X = m_x.data();
+  double* V = m_v.data();
+  double* F = m_f.data();
+  double* G = m_g.data();
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) {
+      X[r * P + s] = x(r, p);
+      V[r * P + s] = v(r, p);
+    }
+  }
+  std::fill(m_f.begin(), m_f.end(), 0.0);
+  const double tau = net.damping_time;
+  const double tiny = 1e-12 * net.block.cell_size;
+  double energy = 0.0;
+  for (std::size_t d = 0; d < directions.size(); ++d) {
+    const int o = m_offset[d];
+    const int begin = std::max(0, -o), end = P - std::max(0, o);
+    energy += direction_springs(begin, end, o, net.rest_length(m_type[d]), tau, tiny, m_k.data() + d * static_cast<std::size_t>(P),
+                                X, X + P, X + 2 * P, V, V + P, V + 2 * P, F, F + P, F + 2 * P, G, G + P, G + 2 * P);
+    direction_ends(begin, end, o, G, G + P, G + 2 * P, F, F + P, F + 2 * P);
+  }
+  const double kappa = net.stiffness.volume_modulus;
+  if (kappa > 0.0) {
+    const double h = net.block.cell_size;
+    const int stride = m_pad + P;
+    energy += cell_volumes(P - m_pad, m_corner.data(), 1.0 / (4.0 * h), kappa * h * h * h, tau, m_cell.data(), X, X + P,
+                           X + 2 * P, V, V + P, V + 2 * P, m_q.data(), stride, m_pad);
+    cell_volume_forces(P, m_corner.data(), m_q.data(), stride, m_pad, F, F + P, F + 2 * P);
+  }
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) f(r, p) = F[r * P + s];
+  }
+  return energy;
+}
+
+} // namespace kerf

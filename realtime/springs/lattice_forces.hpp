@@ -1,0 +1,56 @@
+#pragma once
+// LatticeForces: the spring network's internal forces (the same as network_forces) computed on
+// the regular lattice of the block while no vertex has been split: every spring of the block is
+// one of 13 lattice directions from a lattice point, and every cell one lattice point (its lower
+// corner), so the force loops run over contiguous, unit-stride arrays and vectorise (SIMD lanes
+// = neighbouring lattice points) instead of gathering and scattering per spring.
+
+#include "realtime/springs/spring_network.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace kerf {
+
+/// Network forces on the block's lattice (paper 000 §2.1's cubic cells, springs as in
+/// network_forces). Built for one network (allocates); `evaluate` uses the lattice while the
+/// network still has the cells, corners and constants it was built with (its `topology` count
+/// unchanged, i.e. no tear since) and falls back to network_forces afterwards. Allocation-free.
+class LatticeForces {
+public:
+  LatticeForces() = default;
+  /// Lattice arrays of `net`: per direction and lattice point the summed constant of the
+  /// (merged) springs that start there, per lattice point whether a cell starts there.
+  explicit LatticeForces(const SpringNetwork& net);
+
+  /// True if `net` is still the network this was built for (no vertex split since).
+  [[nodiscard]] bool applies(const SpringNetwork& net) const noexcept;
+
+  /// f (3 x capacity, overwritten for the nodes in use) = the internal forces at positions x and
+  /// velocities v, exactly the sum network_forces computes (to round-off):
+  ///   spring:  f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = (x_b − x_a)/l   (and −that on b);
+  ///   volume:  f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a.
+  /// Returns the elastic energy Σ ½ k (l − L)² + Σ ½ κ V₀ (J − 1)² [J].
+  double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
+                  Eigen::Matrix3Xd& f) noexcept;
+
+private:
+  std::uint64_t m_topology = 0;
+  int m_node_count = -1;
+  int m_points = 0;                    ///< lattice points (Nx+1)(Ny+1)(Nz+1)
+  int m_pad = 0;                       ///< leading zero entries of the cell arrays (the corner-7 offset)
+  std::array<int, 13> m_offset{};      ///< linear offset of each direction
+  std::array<int, 13> m_type{};        ///< 1 edge, 2 face diagonal, 3 body diagonal
+  std::array<int, 8> m_corner{};       ///< linear offset of each cell corner
+  std::vector<int> m_slot;             ///< lattice point of each node
+  std::vector<double> m_k;             ///< 13 x points: summed spring constant [N/m]
+  std::vector<double> m_cell;          ///< points: 1 where a cell starts, else 0
+  std::vector<double> m_x, m_v, m_f;   ///< 3 x points each (x, y, z planes)
+  std::vector<double> m_g;             ///< 3 x points: one direction's spring forces
+  std::vector<double> m_q;             ///< 9 x (pad + points): per cell P cof(F)/(4h), columns 0..2
+};
+
+} // namespace kerf

@@ -1,0 +1,180 @@
+// LatticeForces (the vectorised lattice loops) against the independent cell-by-cell sum of
+// cell_forces, and NetworkSystem's own supernodal solves against a dense solve of its matrix.
+
+#include "realtime/springs/lattice_forces.hpp"
+#include "realtime/springs/network_system.hpp"
+#include "tests/realtime/springs/network_fixtures.hpp"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace kerf {
+namespace {
+
+/// Σ over cells of cell_forces (each cell's own 28 springs and volume term): the reference.
+double cell_sum(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& f) {
+  f.setZero();
+  double energy = 0.0;
+  Eigen::Matrix<double, 3, 8> xc, vc, fc;
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(c)];
+    for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]), vc.col(a) = v.col(nodes[static_cast<std::size_t>(a)]);
+    energy += cell_forces(net, c, xc, vc, fc);
+    for (int a = 0; a < 8; ++a) f.col(nodes[static_cast<std::size_t>(a)]) += fc.col(a);
+  }
+  return energy;
+}
+
+/// A 5 x 3 x 4 block (h = 2.5 mm, clay with the volume term, τ = 20 µs) with a third of its
+/// cells pruned, every node displaced by up to 5% of h and given a random velocity.
+struct Scattered {
+  SpringNetwork net;
+  Eigen::Matrix3Xd x, v;
+};
+Scattered scattered_block(unsigned seed) {
+  const double h = 2.5e-3;
+  NetworkBlock block;
+  block.origin = {0.01, -0.02, 0.003};
+  block.cell_size = h;
+  block.cells = {5, 3, 4};
+  std::vector<bool> keep(60);
+  for (std::size_t c = 0; c < keep.size(); ++c) keep[c] = c % 3 != 1;
+  Scattered s{build_spring_network(block, keep, identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0, 2e-5), {}, {}};
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  s.x = s.net.rest;
+  s.v.setZero(3, s.net.node_capacity());
+  for (int n = 0; n < s.net.node_count; ++n)
+    for (int i = 0; i < 3; ++i) s.x(i, n) += 0.05 * h * u(rng), s.v(i, n) = 1e-2 * u(rng);
+  return s;
+}
+
+TEST(LatticeForces, EqualTheCellSum) {
+  for (const unsigned seed : {1u, 2u, 3u}) {
+    Scattered s = scattered_block(seed);
+    LatticeForces lattice(s.net);
+    ASSERT_TRUE(lattice.applies(s.net));
+    Eigen::Matrix3Xd expected(3, s.net.node_capacity()), f(3, s.net.node_capacity());
+    const double expected_energy = cell_sum(s.net, s.x, s.v, expected);
+    const double energy = lattice.evaluate(s.net, s.x, s.v, f);
+    const double scale = expected.leftCols(s.net.node_count).cwiseAbs().maxCoeff();
+    EXPECT_LT((f - expected).leftCols(s.net.node_count).cwiseAbs().maxCoeff(), 1e-12 * scale) << "seed " << seed;
+    EXPECT_NEAR(energy, expected_energy, 1e-12 * expected_energy) << "seed " << seed;
+  }
+}
+
+TEST(LatticeForces, FallsBackToTheSpringLoopAfterASplit) {
+  // A split vertex (two nodes on one lattice point) is not a lattice: evaluate then gives
+  // network_forces, still equal to the cell sum.
+  Scattered s = scattered_block(4);
+  LatticeForces lattice(s.net);
+  int shared = -1; // a node of more than one cell
+  std::vector<int> cells(static_cast<std::size_t>(s.net.node_count), 0);
+  for (const auto& nodes : s.net.cell_nodes)
+    for (int id : nodes) ++cells[static_cast<std::size_t>(id)];
+  for (int n = 0; n < s.net.node_count && shared < 0; ++n)
+    if (cells[static_cast<std::size_t>(n)] >= 2) shared = n;
+  ASSERT_GE(shared, 0);
+  const int copy = s.net.node_count++;
+  s.x.col(copy) = s.x.col(shared) + Eigen::Vector3d(2e-5, 0, 0);
+  s.v.col(copy) = s.v.col(shared);
+  s.net.rest.col(copy) = s.net.rest.col(shared);
+  bool first = true;
+  for (auto& nodes : s.net.cell_nodes)
+    for (int& id : nodes)
+      if (id == shared) {
+        if (!first) id = copy;
+        first = false;
+      }
+  merge_springs(s.net);
+  EXPECT_FALSE(lattice.applies(s.net));
+  EXPECT_FALSE(LatticeForces(s.net).applies(s.net)); // nor is one built on the torn network
+  Eigen::Matrix3Xd expected(3, s.net.node_capacity()), f(3, s.net.node_capacity());
+  cell_sum(s.net, s.x, s.v, expected);
+  lattice.evaluate(s.net, s.x, s.v, f);
+  const double scale = expected.leftCols(s.net.node_count).cwiseAbs().maxCoeff();
+  EXPECT_LT((f - expected).leftCols(s.net.node_count).cwiseAbs().maxCoeff(), 1e-12 * scale);
+}
+
+TEST(NetworkSystem, SolvesAgainstADenseFactorisation) {
+  // A = M/h² + K_T at a displaced state of the pruned block (two corner nodes fixed), solved by
+  // the supernodal solves on CHOLMOD's factor (double) and on its single-precision copy, against
+  // Eigen's dense LLᵀ of the same assembled matrix.
+  Scattered s = scattered_block(5);
+  s.net.constraint[0] = fix_all;
+  s.net.constraint[static_cast<std::size_t>(s.net.node_count - 1)] = fix_x | fix_z;
+  for (const auto precision : {NetworkSystem::SolvePrecision::double_precision, NetworkSystem::SolvePrecision::single_precision}) {
+    NetworkSystem system(s.net, precision);
+    const double dt = 1e-3;
+    system.assemble(s.net, s.x, 1.0 / (dt * dt), 1.0);
+    ASSERT_TRUE(system.factorize());
+    const Eigen::MatrixXd dense = Eigen::MatrixXd(system.matrix()).selfadjointView<Eigen::Lower>();
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    Eigen::VectorXd rhs(system.dof_count()), out(system.dof_count());
+    for (Eigen::Index k = 0; k < rhs.size(); ++k) rhs[k] = u(rng);
+    system.solve(rhs, out);
+    const Eigen::VectorXd expected = dense.llt().solve(rhs);
+    // Double: round-off of a well-conditioned solve; single: the float factor's 6e-8 relative
+    // entries amplified by the condition number of A (~1e3 here).
+    const double tolerance = precision == NetworkSystem::SolvePrecision::double_precision ? 1e-10 : 1e-4;
+    EXPECT_LT((out - expected).norm(), tolerance * expected.norm());
+  }
+}
+
+TEST(NetworkSystem, TearReadyPatternTakesASplitLikeAFreshAnalysis) {
+  // A vertex split bound into the tear-ready pattern (no new analysis) against a fresh analysis of
+  // the torn network: the same solution of A u = b node by node (A = M/h² + K_T at a displaced
+  // state), the unused shadows decoupled.
+  const double h = 2.5e-3;
+  SpringNetwork net = test::full_block(3, h, identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0);
+  for (int n = 0; n < net.node_count; ++n)
+    if (test::grid_of(net, n).z() == 0) net.constraint[static_cast<std::size_t>(n)] = fix_all;
+  NetworkSystem ready;
+  ready.rebuild(net, true);
+  // Split the node at lattice point (1, 1, 1): cells with grid x = 1 take the copy.
+  int centre = -1;
+  for (int n = 0; n < net.node_count; ++n)
+    if (test::grid_of(net, n) == Eigen::Vector3i(1, 1, 1)) centre = n;
+  ASSERT_GE(centre, 0);
+  const int copy = net.node_count++;
+  net.rest.col(copy) = net.rest.col(centre);
+  net.constraint[static_cast<std::size_t>(copy)] = net.constraint[static_cast<std::size_t>(centre)];
+  for (int c = 0; c < net.cell_count(); ++c)
+    if (net.cell_index[static_cast<std::size_t>(c)].x() == 1)
+      for (int& id : net.cell_nodes[static_cast<std::size_t>(c)]) id = id == centre ? copy : id;
+  net.mass[static_cast<std::size_t>(copy)] = 4 * net.cell_mass / 8.0;
+  net.mass[static_cast<std::size_t>(centre)] = 4 * net.cell_mass / 8.0;
+  merge_springs(net);
+  ASSERT_TRUE(ready.bind_split_vertices(net));
+  EXPECT_TRUE(ready.bind_split_vertices(net)); // binding again with nothing new changes nothing
+  NetworkSystem fresh(net);
+
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::Matrix3Xd x = net.rest, b = Eigen::Matrix3Xd::Zero(3, net.node_capacity());
+  for (int n = 0; n < net.node_count; ++n)
+    for (int i = 0; i < 3; ++i) x(i, n) += 0.02 * h * u(rng), b(i, n) = u(rng);
+  const auto solve = [&](NetworkSystem& system) {
+    system.assemble(net, x, 1e6, 1.0);
+    EXPECT_TRUE(system.factorize());
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(system.dof_count()), out(system.dof_count());
+    for (int n = 0; n < net.node_count; ++n)
+      for (int i = 0; i < 3; ++i)
+        if (const int d = system.dof_of()[static_cast<std::size_t>(3 * n + i)]; d >= 0) rhs[d] = b(i, n);
+    system.solve(rhs, out);
+    Eigen::Matrix3Xd solution = Eigen::Matrix3Xd::Zero(3, net.node_count);
+    for (int n = 0; n < net.node_count; ++n)
+      for (int i = 0; i < 3; ++i)
+        if (const int d = system.dof_of()[static_cast<std::size_t>(3 * n + i)]; d >= 0) solution(i, n) = out[d];
+    return solution;
+  };
+  EXPECT_GT(ready.dof_count(), fresh.dof_count()); // the unused shadows
+  const Eigen::Matrix3Xd a = solve(ready), e = solve(fresh);
+  EXPECT_LT((a - e).cwiseAbs().maxCoeff(), 1e-10 * e.cwiseAbs().maxCoeff());
+}
+
+} // namespace
+} // namespace kerf

@@ -1,0 +1,105 @@
+// The spring model as `kerf run` builds and writes it on a scene (gmsh mesh, the scene's
+// trajectory): the embedded fine mesh written as a .vtu series with a .pvd, whose last frame is
+// the fine mesh moved by the final network state. The expected positions are computed here
+// independently: a fresh trilinear NetworkEmbedding of the frame's rest points (its points minus
+// its `displacement`) in the model's final network. Links kerf_experiments (scenes, runs) and
+// VTK (to read the files back).
+
+#include "experiments/run/model_catalogue.hpp"
+#include "experiments/run/run_model.hpp"
+#include "experiments/run/scene_mesh.hpp"
+#include "experiments/scene/scene_reader.hpp"
+#include "realtime/springs/network_embedding.hpp"
+#include "realtime/springs/spring_network_model.hpp"
+
+#include <gtest/gtest.h>
+#include <vtkDataArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkUnstructuredGrid.h>
+#include <vtkXMLUnstructuredGridReader.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+
+using namespace kerf;
+namespace fs = std::filesystem;
+
+TEST(SpringsOnScenes, ClayPullWritesTheEmbeddedMeshSeries) {
+  const Scene scene = read_scene(fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / "clay_pull.toml");
+  const TetMesh mesh = scene_mesh(scene);
+  BuiltModel built = make_model("springs", scene, mesh, {{"integrator", "implicit"}});
+  // The model proper behind the recording wrapper (BuiltModel::core_model).
+  const auto* springs = dynamic_cast<const SpringNetworkModel*>(&built.core_model());
+  ASSERT_NE(springs, nullptr);
+  std::vector<std::string> names;
+  for (const Tool& t : scene.tools) names.push_back(t.name);
+  const std::vector<SampledTrajectory> trajectories = sample_scene_trajectories(scene);
+  const ForceProfile profile = run_model(*built.model, names, trajectories);
+  const fs::path dir = fs::temp_directory_path() / "kerf_test_springs_series";
+  fs::remove_all(dir);
+  write_run(dir, profile, run_manifest(scene, built, mesh, profile, 0.0), &built);
+
+  std::ifstream manifest_file(dir / "manifest.json");
+  const nlohmann::json manifest = nlohmann::json::parse(manifest_file);
+  ASSERT_TRUE(manifest.contains("fields"));
+  EXPECT_EQ(manifest["fields"]["series"], "springs.pvd");
+  const int frames = manifest["fields"]["frames"].get<int>();
+  EXPECT_GE(frames, 100); // one per 1/100 of the trajectory, and the final state
+
+  // The .pvd lists every frame in time order; the last is at the last sample's time.
+  std::ifstream pvd(dir / "springs.pvd");
+  std::stringstream text;
+  text << pvd.rdbuf();
+  const std::string body = text.str();
+  const std::regex entry("timestep=\"([^\"]+)\"[^>]*file=\"([^\"]+)\"");
+  std::vector<std::pair<double, std::string>> listed;
+  for (auto it = std::sregex_iterator(body.begin(), body.end(), entry); it != std::sregex_iterator(); ++it)
+    listed.emplace_back(std::stod((*it)[1]), (*it)[2]);
+  ASSERT_EQ(static_cast<int>(listed.size()), frames);
+  for (std::size_t k = 1; k < listed.size(); ++k) EXPECT_GT(listed[k].first, listed[k - 1].first);
+  const double dt = 1.0 / trajectories.front().rate;
+  EXPECT_NEAR(listed.back().first, static_cast<double>(trajectories.front().samples.size()) * dt, 1e-9);
+
+  vtkNew<vtkXMLUnstructuredGridReader> reader;
+  reader->SetFileName((dir / listed.back().second).string().c_str());
+  reader->Update();
+  vtkUnstructuredGrid* grid = reader->GetOutput();
+  ASSERT_NE(grid, nullptr);
+  ASSERT_EQ(grid->GetNumberOfCells(), mesh.tets.rows()); // untorn: the scene's tetrahedra
+  ASSERT_EQ(grid->GetNumberOfPoints(), mesh.nodes.rows());
+  vtkDataArray* displacement = grid->GetPointData()->GetArray("displacement");
+  ASSERT_NE(displacement, nullptr);
+  const auto n = static_cast<Eigen::Index>(grid->GetNumberOfPoints());
+  Eigen::MatrixXd written(n, 3), rest(n, 3);
+  for (Eigen::Index p = 0; p < n; ++p)
+    for (int i = 0; i < 3; ++i) {
+      written(p, i) = grid->GetPoint(p)[i];
+      rest(p, i) = written(p, i) - displacement->GetComponent(p, i);
+    }
+  // The expected positions: the scene mesh's nodes embedded afresh in the final network, each
+  // matched to the written point with the same rest position (to 1 nm).
+  const NetworkEmbedding embedding(springs->network(), mesh.nodes, EmbeddingScheme::trilinear);
+  Eigen::MatrixXd expected(mesh.nodes.rows(), 3);
+  embedding.apply(springs->network(), springs->positions(), expected);
+  const auto key = [](const Eigen::RowVector3d& r) {
+    return std::array<long long, 3>{std::llround(r.x() * 1e9), std::llround(r.y() * 1e9), std::llround(r.z() * 1e9)};
+  };
+  std::map<std::array<long long, 3>, Eigen::Index> node_at;
+  for (Eigen::Index p = 0; p < mesh.nodes.rows(); ++p) node_at[key(mesh.nodes.row(p))] = p;
+  double worst = 0.0;
+  for (Eigen::Index p = 0; p < n; ++p) {
+    const auto it = node_at.find(key(rest.row(p)));
+    ASSERT_NE(it, node_at.end()) << "written point " << p << " has no scene node at its rest position";
+    const double d = (written.row(p) - expected.row(it->second)).cwiseAbs().maxCoeff();
+    worst = std::max(worst, d);
+  }
+  EXPECT_LT(worst, 1e-12);
+  // The pull moved the fine mesh: by about the 8 mm pull at the stylus.
+  EXPECT_GT((written - rest).rowwise().norm().maxCoeff(), 5e-3);
+  EXPECT_GT(embedding.embedded_count(), 0);
+}
