@@ -6,6 +6,7 @@
 #include <dlfcn.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -81,6 +82,30 @@ void hook_free(void* p) {
 // that allocates nothing either). Looked up at run time: other BLAS builds have no such call.
 int (*g_blas_get_threads)() = nullptr;
 void (*g_blas_set_threads)(int) = nullptr;
+// The thread count is process-wide: with several factorisations at once (a study's parallel
+// jobs), the first to enter sets one thread and the last to leave restores the count, so no
+// factorisation runs while another has restored it (which made threaded studies' springs runs
+// differ from serial ones in the last digits).
+std::atomic<int> g_blas_users{0};
+std::atomic<int> g_blas_saved{1};
+
+/// OpenBLAS on one thread for the scope (nothing with another BLAS). Lock-free.
+class SingleThreadedBlas {
+public:
+  SingleThreadedBlas() {
+    if (!g_blas_set_threads) return;
+    if (g_blas_users.fetch_add(1) == 0) {
+      g_blas_saved = g_blas_get_threads();
+      if (g_blas_saved > 1) g_blas_set_threads(1);
+    }
+  }
+  ~SingleThreadedBlas() {
+    if (!g_blas_set_threads) return;
+    if (g_blas_users.fetch_sub(1) == 1 && g_blas_saved > 1) g_blas_set_threads(g_blas_saved);
+  }
+  SingleThreadedBlas(const SingleThreadedBlas&) = delete;
+  SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
+};
 
 void install_lease_hooks() {
   static std::once_flag once;
@@ -349,14 +374,12 @@ bool NetworkSystem::factorize() noexcept {
   a.packed = 1;
   double beta[2] = {0.0, 0.0};
   WorkspaceLease lease;
-  const int blas_threads = g_blas_get_threads ? g_blas_get_threads() : 1;
-  if (blas_threads > 1) g_blas_set_threads(1);
   {
+    const SingleThreadedBlas single;
     const ArmedLease armed(m_update_buffer, lease);
     // LLᵀ = A, A already in the factor's order (cholmod_factorize would first build A(p,p)).
     cholmod_super_numeric(&a, nullptr, beta, m_factor, m_common);
   }
-  if (blas_threads > 1) g_blas_set_threads(blas_threads);
   m_factorized = m_common->status == CHOLMOD_OK && lease.live == 0;
   if (m_factorized && !m_factor_single.empty()) {
     const double* lx = static_cast<const double*>(m_factor->x);
