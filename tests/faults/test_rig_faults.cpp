@@ -377,7 +377,10 @@ TEST(RigFaults, ModelThrowingMidSessionLeavesACompleteSessionFile) {
   const Session s = read_session(file);
   ASSERT_FALSE(s.ticks.empty());
   for (std::size_t k = 0; k < s.ticks.size(); ++k) ASSERT_EQ(s.ticks[k].tick, k);
-  EXPECT_LT(s.ticks.size(), fault_step);
+  // None past the fault: ticks 0 .. fault_step - 1 at most (the tick whose step threw is never
+  // recorded). All of them may be on disk when the writer drained just before the abort (seen
+  // under load: 300 of 300), so nothing lost is no failure.
+  EXPECT_LE(s.ticks.size(), fault_step);
   std::printf("[ measured ] model threw at step %llu: %zu ticks on disk, %llu lost with the process\n",
               static_cast<unsigned long long>(fault_step), s.ticks.size(),
               static_cast<unsigned long long>(fault_step - s.ticks.size()));
