@@ -30,6 +30,12 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
   FrameView view(window.body_renderer(0), *adapter, settings.frame);
   frame_camera(window.camera(), view.bounds(), settings.camera, window.body_aspect());
 
+  // One frame before the servo starts (the body at rest): the first render compiles the shaders
+  // and allocates the GL buffers and Mesa's threads, the longest and most memory-hungry frame,
+  // which would otherwise run beside the servo's first ticks.
+  view.show(viewed.frame());
+  window.render();
+
   ServoLoop loop(viewed, devices, settings.servo, nullptr);
   // The servo statistics are read in the thread that steps the model: only when that is the
   // servo thread itself (single-rate) are they the servo's own, race-free.
