@@ -3,6 +3,7 @@
 #include "viewer/viewed_model.hpp"
 
 #include <chrono>
+#include <cstdlib>
 #include <stdexcept>
 #include <thread>
 
@@ -22,6 +23,13 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
     return out;
   }
 
+  // Mesa's software rasteriser (llvmpipe, what Xvfb and machines without a GPU render with)
+  // starts one rendering thread per core unless LP_NUM_THREADS says otherwise; beside a servo
+  // thread on 2 cores they cost it deadlines (sponge_cut_constant/voxel at 1 kHz: overruns in 3
+  // of 7 viewed sessions with them, in 1 of 7 without; docs/viewer.md). Rendered in this thread
+  // alone the frames still come at about 60 Hz. Read when the first GL context is made, so set
+  // here; a value the user set is kept.
+  ::setenv("LP_NUM_THREADS", "0", 0);
   std::unique_ptr<ModelAdapter> adapter = make_model_adapter(shown, mesh);
   ViewedModel viewed(model, *adapter, 1.0 / settings.display_rate);
   ViewWindowSettings window_settings = settings.window;
