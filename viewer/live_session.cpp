@@ -3,6 +3,7 @@
 #include "viewer/viewed_model.hpp"
 
 #include <chrono>
+#include <cstdlib>
 #include <stdexcept>
 #include <thread>
 
@@ -22,6 +23,13 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
     return out;
   }
 
+  // Mesa's software rasteriser (llvmpipe, what Xvfb and machines without a GPU render with)
+  // starts one rendering thread per core unless LP_NUM_THREADS says otherwise; beside a servo
+  // thread on 2 cores they cost it deadlines (sponge_cut_constant/voxel at 1 kHz: overruns in 3
+  // of 7 viewed sessions with them, in 1 of 7 without; docs/viewer.md). Rendered in this thread
+  // alone the frames still come at about 60 Hz. Read when the first GL context is made, so set
+  // here; a value the user set is kept.
+  ::setenv("LP_NUM_THREADS", "0", 0);
   std::unique_ptr<ModelAdapter> adapter = make_model_adapter(shown, mesh);
   ViewedModel viewed(model, *adapter, 1.0 / settings.display_rate);
   ViewWindowSettings window_settings = settings.window;
@@ -29,6 +37,12 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
   ViewWindow window(window_settings, 1, false);
   FrameView view(window.body_renderer(0), *adapter, settings.frame);
   frame_camera(window.camera(), view.bounds(), settings.camera, window.body_aspect());
+
+  // One frame before the servo starts (the body at rest): the first render compiles the shaders
+  // and allocates the GL buffers and Mesa's threads, the longest and most memory-hungry frame,
+  // which would otherwise run beside the servo's first ticks.
+  view.show(viewed.frame());
+  window.render();
 
   ServoLoop loop(viewed, devices, settings.servo, nullptr);
   // The servo statistics are read in the thread that steps the model: only when that is the
