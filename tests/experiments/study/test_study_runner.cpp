@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <set>
 
 #include <unistd.h>
 
@@ -455,4 +456,18 @@ TEST(StudyRunner, TheCalibrationTrajectoryIsTheSamePathPlayedFaster) {
   EXPECT_LT((a.samples.back().position - b.samples.back().position).norm(), 1e-12);
   EXPECT_LT((a.samples[800].position - b.samples[200].position).norm(), 1e-9); // t = 0.8 s and 0.2 s: 4 mm up
   EXPECT_THROW(calibration_scene(scene, 0.0), std::invalid_argument);
+}
+
+TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
+  // Issue 7: "the study reports calibrated and uncalibrated rows side by side" — the default study
+  // fits every model `kerf calibrate` supports that runs on its scenes: the springs on clay_pull
+  // and the fracture model on potato_rect_cut (voxel runs on neither scene).
+  const StudySpec s = read_study(fs::path(KERF_STUDIES_DIR) / "default.toml");
+  ASSERT_TRUE(s.has_reference);
+  std::set<std::pair<std::string, std::string>> fits;
+  for (const StudyCalibrationFit& f : s.fits) {
+    fits.emplace(f.scene, f.model);
+    EXPECT_NE(f.speed, 1.0); // the scene's own trajectory stays held out
+  }
+  EXPECT_EQ(fits, (std::set<std::pair<std::string, std::string>>{{"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}}));
 }
