@@ -49,6 +49,8 @@
 #include <chrono>
 #include <cmath>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <climits>
 #include <map>
 #include <span>
@@ -224,6 +226,7 @@ struct FiniteStrainSolver::Impl {
   double cohesive_viscous_dissipation = 0.0;
   double committed_time = 0.0;
   bool cohesive_secant = false; // Newton fallback: the secant interface tangent (cohesive_law.hpp)
+  bool poison_residual = false; // fault injection: SolverSettings::residual_fault chose this assembly
   void build_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group);
   template <class VectorType>
   Eigen::Vector3d cohesive_opening(const CohesivePair& pair, std::size_t q, const VectorType& state) const;
@@ -615,6 +618,7 @@ void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::Vec
   out.residual -= f_ext;
   out.internal_norm = f_int.l2_norm();
   out.external_norm = f_ext.l2_norm();
+  if (poison_residual) out.residual *= std::numeric_limits<double>::quiet_NaN(); // fault injection (issue 10)
   if (!std::isfinite(out.residual.l2_norm())) throw FiniteStrainError("finite strain: non-finite residual");
 }
 
@@ -1071,7 +1075,9 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
       // interface tangent takes over (slower, but it does not cycle).
       m.cohesive_secant = m.cohesive_law && it >= m.settings.max_newton_iterations / 3;
       auto t0 = Clock::now();
+      m.poison_residual = m.settings.residual_fault && m.settings.residual_fault(load, it);
       m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
+      m.poison_residual = false;
       report.assembly_seconds += seconds_since(t0);
       const double r = m.free_norm(assembly.residual, la.free_mask);
       report.residual_history.push_back(r);
@@ -1121,6 +1127,7 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
       la.u.add(best_alpha, du);
     }
   } catch (const FiniteStrainError& e) {
+    m.poison_residual = false;
     return fail(e.what());
   } catch (const std::exception& e) { // PETSc/UMFPACK errors (deal.II exceptions are std::exception)
     return fail(std::string("linear solver: ") + e.what());
@@ -1382,22 +1389,40 @@ void FiniteStrainSolver::Impl::write_fields(const VectorType& u, const std::file
   // Quadratic output cells without write_higher_order_cells (dealii-on-debian12.md, "output").
   // (Distributed: DataOut takes this process's locally owned cells.)
   out.build_patches(*m.mapping, static_cast<unsigned>(m.settings.degree));
+  // deal.II reports a failed stream write (a full disk, a file-size limit) as an assertion that
+  // names its own source line, not the file: the message gets the file's name here.
+  auto write_or_name = [](const std::filesystem::path& target, std::ostream& stream,
+                          const std::function<void(std::ostream&)>& body) {
+    try {
+      body(stream);
+      stream.flush();
+    } catch (const std::exception& e) {
+      // deal.II's message: a rule of dashes, then lines; one line of single spaces here.
+      std::string why;
+      for (const char c : std::string(e.what())) {
+        const char d = c == '\n' || c == '\t' ? ' ' : c;
+        if ((d == ' ' || d == '-') && (why.empty() || why.back() == ' ')) continue;
+        why.push_back(d);
+      }
+      throw std::runtime_error("write_fields: writing " + target.string() +
+                               " failed (disk full or file-size limit?): " + why.substr(0, 400));
+    }
+    if (!stream) throw std::runtime_error("write_fields: writing " + target.string() + " failed (disk full or file-size limit?)");
+  };
   if (!m.distributed) {
     std::ofstream stream(file);
     if (!stream) throw std::runtime_error("write_fields: cannot open " + file.string());
-    out.write_vtu(stream);
+    write_or_name(file, stream, [&](std::ostream& s) { out.write_vtu(s); });
     return;
   }
   // One .vtu piece per process beside the .pvtu record that lists them (written by rank 0 after
   // every piece is in place), each atomically.
   auto piece = [&](int rank) { return file.stem().string() + "." + std::to_string(rank) + ".vtu"; };
-  auto write = [](const std::filesystem::path& target, const std::function<void(std::ostream&)>& body) {
+  auto write = [&](const std::filesystem::path& target, const std::function<void(std::ostream&)>& body) {
     write_atomically(target, [&](const std::filesystem::path& tmp) {
       std::ofstream stream(tmp);
       if (!stream) throw std::runtime_error("write_fields: cannot open " + tmp.string());
-      body(stream);
-      stream.flush();
-      if (!stream) throw std::runtime_error("write_fields: writing " + tmp.string() + " failed");
+      write_or_name(tmp, stream, body);
     });
   };
   write(file.parent_path() / piece(rank), [&](std::ostream& stream) { out.write_vtu(stream); });

@@ -100,6 +100,13 @@ enum class LinearSolverChoice {
   iterative  ///< PETSc CG + GAMG with the rigid-body near null space; unpreconditioned-norm stop
 };
 
+/// The load of one equilibrium solve.
+struct LoadState {
+  double load_factor = 0.0;                               ///< scales tractions and prescribed u
+  Eigen::Vector3d tool_position = Eigen::Vector3d::Zero(); ///< tool reference point [m]
+  double time = 0.0; ///< [s] trajectory time; its increment drives the cohesive viscous term
+};
+
 /// Discretisation and solver settings (validated by the solver's constructor).
 struct SolverSettings {
   int degree = 1;        ///< FE_SimplexP degree, 1 or 2
@@ -121,13 +128,12 @@ struct SolverSettings {
   /// Launched by mpirun with N > 1 processes: distribute the mesh over them (true), or solve the
   /// whole problem on this process alone (false, e.g. a serial comparison inside an MPI job).
   bool distribute = true;
-};
-
-/// The load of one equilibrium solve.
-struct LoadState {
-  double load_factor = 0.0;                               ///< scales tractions and prescribed u
-  Eigen::Vector3d tool_position = Eigen::Vector3d::Zero(); ///< tool reference point [m]
-  double time = 0.0; ///< [s] trajectory time; its increment drives the cohesive viscous term
+  /// Fault injection (issue 10, docs/reliability.md; empty in every real run): called before the
+  /// assembly of each Newton iteration with the load being solved and the iteration (0-based);
+  /// when it returns true, that iteration's assembled residual is made NaN, as an overflowing
+  /// material or contact term would make it. `solve` must take it for failure (state restored,
+  /// converged false), never for convergence, so the load path cuts back or stops.
+  std::function<bool(const LoadState& load, int newton_iteration)> residual_fault;
 };
 
 /// The cohesive interface after a converged solve (all zero without one). Energies per the whole

@@ -262,6 +262,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   solver_settings.refinements = settings.refinements;
   solver_settings.linear_solver = settings.linear_solver;
   solver_settings.distribute = settings.distribute;
+  solver_settings.residual_fault = settings.residual_fault;
   reference::FiniteStrainSolver solver(rp.problem, solver_settings);
   // Under mpirun every process runs this function; rank 0 writes the files and the progress. A
   // solver that is not distributed (settings.distribute false: e.g. one of the solves `mpirun kerf

@@ -16,6 +16,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +39,9 @@ struct ReferenceRunSettings {
   /// Off by default until Reference II is complete (docs/cohesive-fracture.md, "Not yet done"): the
   /// cohesive reference of a cutting scene is opt-in (`--fracture auto|on`).
   ReferenceFracture fracture = ReferenceFracture::off;
+  /// Fault injection for tests (issue 10): passed to the solver as
+  /// reference::SolverSettings::residual_fault (a NaN in the chosen Newton iterations' residual).
+  std::function<bool(const reference::LoadState& load, int newton_iteration)> residual_fault;
 };
 
 /// How the scene's tool is coupled to the body in the reference.

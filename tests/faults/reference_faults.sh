@@ -8,7 +8,8 @@
 #      uninterrupted one (every column but cost_s, as written, to the last digit);
 #   3. a full disk (SIGXFSZ ignored and RLIMIT_FSIZE set in the child, so writes fail as on a
 #      full disk instead of killing it): a failure with a message, every finished output whole;
-#      then `--resume` without the limit reproduces the profile;
+#      then `--resume` without the limit reproduces the profile; and a disk that fills between the
+#      checkpoints after samples 5 and 10 (a byte-exact limit): `--resume` continues from sample 5;
 #   4. an absurd load increment (the stylus jumps 2 m instead of 8 mm): the load path cuts back,
 #      or stops with the last converged state saved (profile, manifest with the reason,
 #      checkpoint), never a crash or a NaN.
@@ -127,6 +128,35 @@ for limit in "64 fields" "12 no-fields"; do
   diff <(physics whole/profile.csv) <(physics "$dir/profile.csv") || fail "the profile after a full disk and --resume differs"
   echo "  then --resume ($(grep -o -m1 'resuming after sample [0-9/]*\|no checkpoint' "$dir.resume.log")): the profile equals the uninterrupted one"
 done
+
+# 3b. A disk that fills between two checkpoints: a byte-exact file-size limit (set by Python's
+#    resource module, SIGXFSZ ignored) just under the uninterrupted run's checkpoint after sample
+#    10, which lets the checkpoint after sample 5 (five sample records fewer) through. The run fails
+#    at sample 10 with a message; `--resume` continues from sample 5 and gives the profile.
+ckpt10=$(stat -c %s whole/checkpoint.bin)
+limit=$((ckpt10 - 256))
+set +e
+$py - "$limit" "$kerf" reference coarse.toml --samples $samples --no-fields -o full_ckpt > full_ckpt.log 2>&1 <<'PY'
+import os, resource, signal, sys
+limit = int(sys.argv[1])
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+os.execv(sys.argv[2], sys.argv[2:])
+PY
+rc=$?
+set -e
+[ "$rc" -ne 0 ] && [ "$rc" -lt 128 ] || { cat full_ckpt.log; fail "a run past the $limit-byte limit exited with $rc"; }
+grep -q 'checkpoint' full_ckpt.log || { cat full_ckpt.log; fail "no message naming the checkpoint write"; }
+check_whole full_ckpt
+[ -e full_ckpt/checkpoint.bin ] && [ "$(stat -c %s full_ckpt/checkpoint.bin)" -le "$limit" ] \
+  || fail "the checkpoint after sample 5 is not on disk whole"
+"$kerf" reference coarse.toml --samples $samples --no-fields -o full_ckpt --resume > full_ckpt.resume.log 2>&1 \
+  || { cat full_ckpt.resume.log; fail "resume after the disk filled between checkpoints"; }
+grep -q "resuming after sample 5/$samples" full_ckpt.resume.log || { cat full_ckpt.resume.log; fail "did not resume from the checkpoint after sample 5"; }
+check_whole full_ckpt
+diff <(physics whole/profile.csv) <(physics full_ckpt/profile.csv) || fail "the profile after the disk filled and --resume differs"
+echo "full disk between checkpoints ($limit-byte limit; checkpoint after sample 10 is $ckpt10 bytes): exit $rc: $(grep -m1 'checkpoint' full_ckpt.log | cut -c1-160)"
+echo "  then --resume (resuming after sample 5/$samples): the profile equals the uninterrupted one"
 
 # 4. An absurd load increment: the stylus jumps 2 m up (the block is 20 mm deep) between the two
 #    samples solved.

@@ -77,5 +77,38 @@ TEST(LoadPath, StopsNamingTheSampleAndKeepsTheLastConvergedState) {
   EXPECT_THROW((void)LoadPath(solver, LoadState{}, LoadPathSettings{-1}), std::invalid_argument);
 }
 
+// A NaN in the residual (reference::SolverSettings::residual_fault, issue 10) is a failed solve:
+// never "converged" (a NaN compares false with every tolerance, so a convergence test written the
+// other way round would pass it), the state restored; the load path cuts back and, once the fault
+// is gone, reaches the equilibrium a clean solver reaches (path independence, as above).
+TEST(LoadPath, NaNInTheResidualIsAFailedSolveAndIsCutBack) {
+  const FiniteStrainProblem p = stretched_cube();
+  SolverSettings faulty;
+  int calls = 0;
+  faulty.residual_fault = [&calls](const LoadState&, int) {
+    ++calls;
+    return calls <= 2; // the first assembly of the lone solve and of the path's first attempt
+  };
+  FiniteStrainSolver solver(p, faulty);
+  const std::vector<double> before = solver.state();
+  const EquilibriumReport failed = solver.solve({0.1, Eigen::Vector3d::Zero()});
+  EXPECT_FALSE(failed.converged);
+  EXPECT_NE(failed.failure.find("non-finite residual"), std::string::npos) << failed.failure;
+  EXPECT_EQ(solver.state(), before);
+
+  LoadPath path(solver, LoadState{});
+  const LoadStepReport r = path.advance({LoadState{1.0, Eigen::Vector3d::Zero()}, 3, 0.5});
+  ASSERT_TRUE(r.converged);
+  EXPECT_GE(r.cutbacks, 1); // the poisoned first attempt
+  FiniteStrainSolver clean(p, SolverSettings{});
+  EquilibriumReport f;
+  for (int k = 1; k <= 20; ++k) {
+    f = clean.solve({0.05 * k, Eigen::Vector3d::Zero()});
+    ASSERT_TRUE(f.converged) << f.failure;
+  }
+  const Eigen::Vector3d X(0.01, 0.01, 0.01);
+  EXPECT_LT((solver.displacement_at(X) - clean.displacement_at(X)).norm(), 1e-9 * clean.displacement_at(X).norm());
+}
+
 } // namespace
 } // namespace kerf::reference

@@ -143,5 +143,66 @@ TEST(ReferenceRun, ResumeFromACheckpointGivesTheUninterruptedProfile) {
   EXPECT_THROW(run_reference(c.scene, c.mesh, s, dir), std::runtime_error);
 }
 
+// Fault injection (issue 10, docs/reliability.md): a NaN in the assembled residual of a Newton
+// iteration (reference::SolverSettings::residual_fault), as an overflowing material or contact term
+// would make it.
+//  - Once, in the first attempt at sample 2: the solve must fail rather than "converge" on a NaN
+//    norm, the load path cuts the increment back and the run goes on to the clean run's equilibria
+//    (hyperelastic equilibrium at a given load does not depend on the increments that reached it,
+//    so the forces agree to the Newton tolerance, 1e-9 of the force scale).
+//  - In every iteration past sample 2: the path stops after its cut-backs; the manifest names the
+//    sample and the non-finite residual; the profile holds the converged samples 0-2; the last
+//    converged state is in checkpoint.bin, and --resume without the fault reproduces the clean
+//    profile bit for bit (the same state and load as the clean run had after sample 2).
+TEST(ReferenceRun, NaNInTheResidualCutsBackOrStopsWithTheLastStateSaved) {
+  const ClayPull c;
+  ReferenceRunSettings s;
+  s.sample_indices = reference_sample_indices(c.samples, 5);
+  s.write_fields = false;
+  s.checkpoint_every = 10; // no regular checkpoint within 5 samples: only the stop writes one
+  const ForceProfile clean = run_reference(c.scene, c.mesh, s, scratch("nan_clean"));
+  ASSERT_EQ(clean.rows.size(), 5u);
+  const double t1 = clean.rows[1].t, t2 = clean.rows[2].t;
+
+  bool poisoned = false;
+  s.residual_fault = [&](const reference::LoadState& load, int) {
+    if (load.time <= t1 || poisoned) return false;
+    poisoned = true;
+    return true;
+  };
+  const fs::path once_dir = scratch("nan_once");
+  const ForceProfile once = run_reference(c.scene, c.mesh, s, once_dir);
+  EXPECT_TRUE(poisoned);
+  const nlohmann::json m_once = read_json(once_dir / "manifest.json");
+  EXPECT_TRUE(m_once.at("stopped").is_null());
+  EXPECT_GE(m_once.at("samples").at(2).at("cutbacks").get<int>(), 1);
+  ASSERT_EQ(once.rows.size(), clean.rows.size());
+  for (std::size_t k = 0; k < clean.rows.size(); ++k) {
+    ASSERT_TRUE(once.rows[k].force.allFinite()) << "row " << k;
+    EXPECT_LE((once.rows[k].force - clean.rows[k].force).norm(), 1e-6 * clean.rows[k].force.norm() + 1e-12)
+        << "row " << k;
+  }
+
+  s.residual_fault = [&](const reference::LoadState& load, int) { return load.time > t2; };
+  const fs::path dir = scratch("nan_always");
+  const ForceProfile stopped = run_reference(c.scene, c.mesh, s, dir);
+  ASSERT_EQ(stopped.rows.size(), 3u);
+  const nlohmann::json m = read_json(dir / "manifest.json");
+  ASSERT_TRUE(m.at("stopped").is_string());
+  const std::string why = m.at("stopped").get<std::string>();
+  EXPECT_NE(why.find("non-finite residual"), std::string::npos) << why;
+  EXPECT_NE(why.find("last converged state"), std::string::npos) << why;
+  EXPECT_EQ(read_profile_csv(dir / "profile.csv").rows.size(), 3u);
+  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
+
+  s.residual_fault = nullptr;
+  s.resume = true;
+  const ForceProfile resumed = run_reference(c.scene, c.mesh, s, dir);
+  EXPECT_EQ(read_json(dir / "manifest.json").at("resumed_after_sample"), 3);
+  ASSERT_EQ(resumed.rows.size(), clean.rows.size());
+  for (std::size_t k = 0; k < clean.rows.size(); ++k)
+    EXPECT_EQ(resumed.rows[k].force, clean.rows[k].force) << "row " << k; // bit for bit
+}
+
 } // namespace
 } // namespace kerf
