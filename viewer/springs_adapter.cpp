@@ -44,17 +44,12 @@ std::vector<int> torn_host_cells(const TornTetMesh& torn, const SpringNetwork& n
       host[p] = given;
       continue;
     }
-    // The up to 8 cells whose closed boxes hold q: q's own, and across each face it lies on.
+    // The cells whose closed boxes hold q: q's own and its neighbours across the faces, edges and
+    // corners q lies on, on either side (q = 0.035 m / 0.005 m rounds to just under 7: the cell
+    // above the face holds it too).
     const Eigen::Vector3i base = q.array().floor().cast<int>();
-    for (int k = 0; k < 8 && host[p] < 0; ++k) {
-      Eigen::Vector3i g = base;
-      bool on_faces = true;
-      for (int i = 0; i < 3; ++i)
-        if ((k >> i) & 1) {
-          if (q[i] - base[i] < eps) g[i] -= 1;
-          else on_faces = false;
-        }
-      if (!on_faces) continue;
+    for (int k = 0; k < 27 && host[p] < 0; ++k) {
+      const Eigen::Vector3i g = base + Eigen::Vector3i(k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1);
       const int c = net.cell_at_index(g);
       if (c >= 0 && label[static_cast<std::size_t>(c)] == piece[p] && holds(c, q)) host[p] = c;
     }
