@@ -51,4 +51,7 @@ void write_manifest(const nlohmann::json& manifest, const std::filesystem::path&
 /// hash of every manifest. Throws std::runtime_error if the file cannot be read.
 std::string file_sha256(const std::filesystem::path& file);
 
+/// Lower-case hex SHA-256 of `text` (64 digits), e.g. the study's reference cache key.
+std::string text_sha256(const std::string& text);
+
 } // namespace kerf

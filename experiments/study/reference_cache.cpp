@@ -5,11 +5,8 @@
 #include "reference/load_path.hpp"
 #include "reference/mpi_processes.hpp"
 
-#include <openssl/evp.h>
 
-#include <array>
 #include <cstdio>
-#include <memory>
 #include <stdexcept>
 
 namespace kerf {
@@ -25,23 +22,6 @@ ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, in
   settings.fracture = spec.fracture;
   settings.distribute = false; // one process per solve: the study spreads whole solves over its ranks
   return settings;
-}
-
-std::string text_sha256(const std::string& text) {
-  std::unique_ptr<EVP_MD_CTX, void (*)(EVP_MD_CTX*)> ctx(EVP_MD_CTX_new(), &EVP_MD_CTX_free);
-  if (!ctx || EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr) != 1 ||
-      EVP_DigestUpdate(ctx.get(), text.data(), text.size()) != 1)
-    throw std::runtime_error("SHA-256 unavailable");
-  std::array<unsigned char, EVP_MAX_MD_SIZE> digest{};
-  unsigned int length = 0;
-  EVP_DigestFinal_ex(ctx.get(), digest.data(), &length);
-  static constexpr char hex[] = "0123456789abcdef";
-  std::string out;
-  for (unsigned int i = 0; i < length; ++i) {
-    out += hex[digest[i] >> 4];
-    out += hex[digest[i] & 15];
-  }
-  return out;
 }
 
 namespace {

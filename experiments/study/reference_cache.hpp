@@ -43,7 +43,4 @@ struct ReferenceCacheKey {
 /// Throws std::runtime_error if the scene or geometry file cannot be read.
 ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSettings& settings);
 
-/// SHA-256 of `text`, 64 lowercase hex digits.
-std::string text_sha256(const std::string& text);
-
 } // namespace kerf

@@ -139,6 +139,30 @@ Eigen::Matrix3d cell_deformation_gradient(const Eigen::Matrix<double, 3, 8>& cor
   return F;
 }
 
+namespace {
+
+/// The per-cell volume term of one cell with corners `x`, velocities `v` (docs/spring-network.md):
+/// W = ½ κ V₀ (J − 1)², f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a, added to `f`; returns W.
+double add_cell_volume_forces(double kappa, double tau, double h, const Eigen::Matrix<double, 3, 8>& x,
+                              const Eigen::Matrix<double, 3, 8>& v, Eigen::Matrix<double, 3, 8>& f) noexcept {
+  const double V0 = h * h * h;
+  const Eigen::Matrix3d F = cell_deformation_gradient(x, h);
+  const double J = F.determinant();
+  const Eigen::Matrix3d cof = cofactor(F);
+  Eigen::Matrix<double, 3, 8> dJ; // ∂J/∂x_a = cof(F) g_a
+  double J_rate = 0.0;
+  for (int a = 0; a < 8; ++a) {
+    dJ.col(a) = cof * (corner_sign(a) / (4.0 * h));
+    J_rate += dJ.col(a).dot(v.col(a));
+  }
+  // f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a
+  const double pressure = kappa * V0 * ((J - 1.0) + tau * J_rate);
+  f -= pressure * dJ;
+  return 0.5 * kappa * V0 * (J - 1.0) * (J - 1.0);
+}
+
+} // namespace
+
 double cell_forces(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
                    const Eigen::Matrix<double, 3, 8>& v, Eigen::Matrix<double, 3, 8>& f) noexcept {
   (void)cell;
@@ -161,22 +185,7 @@ double cell_forces(const SpringNetwork& net, int cell, const Eigen::Matrix<doubl
     energy += 0.5 * k * stretch * stretch;
   }
   const double kappa = net.stiffness.volume_modulus;
-  if (kappa > 0.0) {
-    const double h = net.block.cell_size;
-    const double V0 = h * h * h;
-    const Eigen::Matrix3d F = cell_deformation_gradient(x, h);
-    const double J = F.determinant();
-    const Eigen::Matrix3d cof = cofactor(F);
-    Eigen::Matrix<double, 3, 8> dJ; // ∂J/∂x_a = cof(F) g_a
-    double J_rate = 0.0;
-    for (int a = 0; a < 8; ++a) {
-      dJ.col(a) = cof * (corner_sign(a) / (4.0 * h));
-      J_rate += dJ.col(a).dot(v.col(a));
-    }
-    // f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a
-    f -= kappa * V0 * ((J - 1.0) + tau * J_rate) * dJ;
-    energy += 0.5 * kappa * V0 * (J - 1.0) * (J - 1.0);
-  }
+  if (kappa > 0.0) energy += add_cell_volume_forces(kappa, tau, net.block.cell_size, x, v, f);
   return energy;
 }
 
@@ -239,24 +248,15 @@ double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const
   }
   const double kappa = net.stiffness.volume_modulus;
   if (kappa > 0.0) {
-    const double h = net.block.cell_size;
-    const double V0 = h * h * h;
-    Eigen::Matrix<double, 3, 8> xc;
+    Eigen::Matrix<double, 3, 8> xc, vc, fc;
     for (const auto& nodes : net.cell_nodes) {
-      for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
-      const Eigen::Matrix3d F = cell_deformation_gradient(xc, h);
-      const double J = F.determinant();
-      const Eigen::Matrix3d cof = cofactor(F);
-      Eigen::Matrix<double, 3, 8> dJ; // ∂J/∂x_a = cof(F) g_a
-      double J_rate = 0.0;
       for (int a = 0; a < 8; ++a) {
-        dJ.col(a) = cof * (corner_sign(a) / (4.0 * h));
-        J_rate += dJ.col(a).dot(v.col(nodes[static_cast<std::size_t>(a)]));
+        xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
+        vc.col(a) = v.col(nodes[static_cast<std::size_t>(a)]);
       }
-      // f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a
-      const double pressure = kappa * V0 * ((J - 1.0) + tau * J_rate);
-      for (int a = 0; a < 8; ++a) f.col(nodes[static_cast<std::size_t>(a)]) -= pressure * dJ.col(a);
-      energy += 0.5 * kappa * V0 * (J - 1.0) * (J - 1.0);
+      fc.setZero();
+      energy += add_cell_volume_forces(kappa, tau, net.block.cell_size, xc, vc, fc);
+      for (int a = 0; a < 8; ++a) f.col(nodes[static_cast<std::size_t>(a)]) += fc.col(a);
     }
   }
   return energy;
