@@ -100,6 +100,7 @@ public:
     });
     nlohmann::json j;
     j["series"] = "springs.pvd";
+    j["points"] = "deformed"; // the .vtu points are the moved mesh; "displacement" = moved − rest
     j["frames"] = files.size();
     j["frame_interval_s"] = m_interval;
     j["embedding"] = "trilinear";

@@ -163,8 +163,9 @@ TEST(ModelAdapter, EachCatalogueModelIsReadByItsOwnAdapter) {
 }
 
 // A .pvd written like the reference's (kerf's VTU writer, a displacement field, steps listed
-// out of order) reads back sorted, with points moved by exactly the displacement.
-TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {
+// out of order) reads back sorted, with points moved by exactly the displacement; the same
+// files read as a series of deformed positions keep their points as written.
+TEST(PvdSeries, ReadsStepsAtTheirDeformedPositions) {
   const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_pvd_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir / "fields");
   TetMesh mesh;
@@ -184,7 +185,8 @@ TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {
            "<DataSet timestep=\"2.5\" file=\"fields/step_1.vtu\"/>\n<DataSet timestep=\"0\" file=\"fields/step_0.vtu\"/>\n"
            "</Collection>\n</VTKFile>\n";
   }
-  PvdSeries series(dir / "fields.pvd");
+  // Written at rest positions (as the reference's fields.pvd): shown at X + u.
+  PvdSeries series(dir / "fields.pvd", SeriesPoints::rest);
   ASSERT_EQ(series.times().size(), 2u);
   EXPECT_EQ(series.times()[0], 0.0);
   EXPECT_EQ(series.times()[1], 2.5);
@@ -198,6 +200,16 @@ TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {
     moved->GetPoint(i, p);
     EXPECT_DOUBLE_EQ(p[2], mesh.nodes(i, 2) + 0.5);
   }
-  EXPECT_THROW(PvdSeries(dir / "missing.pvd"), std::runtime_error);
+  // The same files read as a series of deformed positions (as the spring network's springs.pvd
+  // writes them): shown where they are, not moved by u a second time.
+  PvdSeries as_written(dir / "fields.pvd", SeriesPoints::deformed);
+  vtkDataSet* kept = as_written.deformed(1);
+  ASSERT_EQ(kept->GetNumberOfPoints(), 4);
+  for (vtkIdType i = 0; i < 4; ++i) {
+    double p[3];
+    kept->GetPoint(i, p);
+    EXPECT_DOUBLE_EQ(p[2], mesh.nodes(i, 2));
+  }
+  EXPECT_THROW(PvdSeries(dir / "missing.pvd", SeriesPoints::rest), std::runtime_error);
   std::filesystem::remove_all(dir);
 }
