@@ -134,11 +134,13 @@ void scene_screenshot(const ViewOptions& o, const Scene& scene, const TetMesh& m
       view.extend_bounds(s.position + Eigen::Vector3d::Constant(r));
     }
   }
-  frame_camera(window.camera(), view.bounds(), parse_camera(o.camera), window.body_aspect());
   const double at = o.at >= 0.0 ? o.at : 0.0;
   const std::array<double, 1> times{at};
   step_through(viewed, trajectories, times, [&](const ViewFrame& f) { view.show(f); },
                [&](double force) { view.note_force(force); });
+  // The camera frames the body as shown too (torn pieces carried beyond the rest block).
+  for (Eigen::Index i = 0; i < view.shown().points.rows(); ++i) view.extend_bounds(view.shown().points.row(i).transpose());
+  frame_camera(window.camera(), view.bounds(), parse_camera(o.camera), window.body_aspect());
   window.write_png(o.screenshot);
   std::printf("wrote %s (%s / %s at t = %.4f s)\n", o.screenshot.c_str(), scene.name.c_str(), o.model.c_str(), at);
 }
