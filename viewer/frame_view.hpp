@@ -42,6 +42,8 @@ public:
   /// Extends the box the camera frames (e.g. by a tool's whole path).
   void extend_bounds(const Eigen::Vector3d& p) { m_bounds.extend(p); }
   [[nodiscard]] BodyView& body() { return m_body; }
+  /// The body as last shown (positions, rest positions, cells) [m].
+  [[nodiscard]] const BodyGeometry& shown() const { return m_geometry; }
 
 private:
   ModelAdapter& m_adapter;

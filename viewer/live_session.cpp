@@ -103,6 +103,7 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
   }
   out.frames_published = viewed.frames_published();
   out.max_capture_seconds = viewed.max_capture_seconds();
+  out.blocked_snapshots = viewed.blocked_snapshots();
   out.mean_render_seconds = out.frames_rendered ? render_total / static_cast<double>(out.frames_rendered) : 0.0;
   return out;
 }

@@ -23,7 +23,7 @@ vtkXMLDataElement* find_child(vtkXMLDataElement* e, const char* name) {
 
 } // namespace
 
-PvdSeries::PvdSeries(const std::filesystem::path& pvd) : m_pvd(pvd) {
+PvdSeries::PvdSeries(const std::filesystem::path& pvd, SeriesPoints points) : m_pvd(pvd), m_points(points) {
   auto parser = vtkSmartPointer<vtkXMLDataParser>::New();
   parser->SetFileName(pvd.c_str());
   if (!std::filesystem::exists(pvd) || parser->Parse() == 0)
@@ -66,15 +66,19 @@ vtkDataSet* PvdSeries::deformed(std::size_t k) {
   vtkUnstructuredGrid* grid = reader->GetOutput();
   if (!grid || !grid->GetPointData()->GetArray("displacement"))
     throw std::runtime_error("viewer: " + file.string() + " has no point data \"displacement\"");
-  // x = X + u
-  auto warp = vtkSmartPointer<vtkWarpVector>::New();
-  warp->SetInputData(grid);
-  warp->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "displacement");
-  warp->SetScaleFactor(1.0);
-  warp->Update();
   vtkSmartPointer<vtkDataSet> out;
-  out.TakeReference(warp->GetOutput()->NewInstance());
-  out->DeepCopy(warp->GetOutput());
+  if (m_points == SeriesPoints::deformed) { // x as written
+    out.TakeReference(grid->NewInstance());
+    out->DeepCopy(grid);
+  } else { // x = X + u
+    auto warp = vtkSmartPointer<vtkWarpVector>::New();
+    warp->SetInputData(grid);
+    warp->SetInputArrayToProcess(0, 0, 0, vtkDataObject::FIELD_ASSOCIATION_POINTS, "displacement");
+    warp->SetScaleFactor(1.0);
+    warp->Update();
+    out.TakeReference(warp->GetOutput()->NewInstance());
+    out->DeepCopy(warp->GetOutput());
+  }
   m_cache[k] = out;
   return out;
 }

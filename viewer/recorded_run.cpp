@@ -138,12 +138,25 @@ RecordedRun::RecordedRun(const std::filesystem::path& dir, int frames) {
 
   const TetMesh mesh = scene_mesh(*m_scene);
   for (Eigen::Index i = 0; i < mesh.nodes.rows(); ++i) m_bounds.extend(mesh.nodes.row(i).transpose());
-  // The run's own series, if it wrote one.
+  // The run's own series, if it wrote one, and what its points are: the reference's fields.pvd
+  // holds rest positions (deal.II's DataOut on the reference mapping); a series named in the
+  // manifest says so in fields.points, "deformed" when it does not (the spring network's
+  // springs.pvd, the one such series, has always held the moved mesh); a lone .pvd otherwise is
+  // taken as ParaView's usual rest positions plus displacement.
   fs::path series;
+  SeriesPoints points = SeriesPoints::rest;
   if (fs::exists(dir / "fields.pvd")) series = dir / "fields.pvd";
-  else if (manifest.contains("fields") && manifest["fields"].is_object() && manifest["fields"].contains("series"))
-    series = dir / manifest["fields"]["series"].get<std::string>();
-  else {
+  else if (manifest.contains("fields") && manifest["fields"].is_object() && manifest["fields"].contains("series")) {
+    const nlohmann::json& fields = manifest["fields"];
+    series = dir / fields["series"].get<std::string>();
+    points = SeriesPoints::deformed;
+    if (fields.contains("points")) {
+      const std::string p = fields["points"].is_string() ? fields["points"].get<std::string>() : std::string();
+      if (p == "rest") points = SeriesPoints::rest;
+      else if (p != "deformed")
+        throw std::runtime_error("viewer: " + (dir / "manifest.json").string() + ": fields.points must be \"rest\" or \"deformed\"");
+    }
+  } else {
     std::vector<fs::path> found;
     for (const auto& e : fs::directory_iterator(dir))
       if (e.path().extension() == ".pvd") found.push_back(e.path());
@@ -152,8 +165,13 @@ RecordedRun::RecordedRun(const std::filesystem::path& dir, int frames) {
   if (m_model_name == "reference" && series.empty())
     throw std::runtime_error("viewer: reference run " + dir.string() + " has no fields.pvd (run without --no-fields)");
   if (!series.empty()) {
-    m_pvd = std::make_unique<PvdSeries>(series);
+    m_pvd = std::make_unique<PvdSeries>(series, points);
     m_series_name = series.filename().string();
+    // The body at the series' last step in view too (torn pieces carried beyond the rest block).
+    double b[6];
+    m_pvd->deformed(m_pvd->times().size() - 1)->GetBounds(b);
+    m_bounds.extend(Eigen::Vector3d(b[0], b[2], b[4]));
+    m_bounds.extend(Eigen::Vector3d(b[1], b[3], b[5]));
     return;
   }
 
@@ -186,6 +204,9 @@ RecordedRun::RecordedRun(const std::filesystem::path& dir, int frames) {
     if (f.tool_count > 0) m_replay_difference = std::max(m_replay_difference, (f.force[0].force - first[row]->force).norm());
   });
   m_frame_times.resize(m_frames.size());
+  // Every snapshot's body in view too.
+  for (const BodyGeometry& g : m_frames)
+    for (Eigen::Index i = 0; i < g.points.rows(); ++i) m_bounds.extend(g.points.row(i).transpose());
 }
 
 RecordedRun::~RecordedRun() = default;

@@ -41,7 +41,8 @@ public:
   [[nodiscard]] bool has_series() const { return m_pvd != nullptr; }
   /// Time of the last profile row [s].
   [[nodiscard]] double duration() const { return m_duration; }
-  /// The rest body's bounding box with the tools' recorded positions [m].
+  /// The bounding box [m] of the rest body, the tools' recorded positions, and the moved body:
+  /// a series' last step, or every snapshot of a re-stepped model.
   [[nodiscard]] Eigen::AlignedBox3d bounds() const { return m_bounds; }
   /// The first tool's force-displacement curve: per profile row of that tool, the time [s], the
   /// distance of the tool from its first recorded position [m] and the force magnitude [N].

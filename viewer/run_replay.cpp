@@ -52,6 +52,7 @@ struct Replay {
   std::vector<vtkSmartPointer<vtkTable>> markers;
   vtkSmartPointer<vtkChartXY> chart;
   double colour_max = 0.0;
+  Colouring colouring = Colouring::displacement;
   bool text = true;
 
   void show(double t) {
@@ -60,8 +61,11 @@ struct Replay {
       runs[i]->show(t, *views[i], text);
       largest = std::max(largest, views[i]->data_maximum());
     }
-    // One colour scale for all runs, so equal colours mean equal values side by side.
-    const double top = colour_max > 0.0 ? colour_max : largest;
+    // One colour scale for all runs, so equal colours mean equal values side by side; the
+    // automatic one no lower than the live view's floors (FrameView: 0.1 mm, 1 kPa), so that a
+    // body at rest is one colour, not round-off noise spread over the whole scale.
+    const double lowest = colouring == Colouring::displacement ? 1e-4 : 1e3;
+    const double top = colour_max > 0.0 ? colour_max : std::max(largest, lowest);
     for (auto& v : views) v->set_colour_range(top);
     for (std::size_t i = 0; i < markers.size(); ++i) {
       const std::size_t k = runs[i]->curve_index(t);
@@ -88,6 +92,7 @@ void replay_runs(const ReplaySettings& settings) {
   if (settings.runs.empty()) throw std::invalid_argument("viewer: no run directory to replay");
   Replay replay;
   replay.colour_max = settings.colour_max;
+  replay.colouring = settings.colouring;
   replay.text = settings.text;
   double duration = 0.0, force_max = 0.1;
   Eigen::AlignedBox3d bounds;

@@ -1,7 +1,6 @@
 #include "viewer/springs_adapter.hpp"
 
 #include "realtime/springs/torn_tet_mesh.hpp"
-#include "realtime/springs/vertex_tearing.hpp"
 
 #include <cstdio>
 #include <stdexcept>
@@ -14,53 +13,6 @@ namespace {
 /// pairs that differ in exactly one bit.
 constexpr std::array<std::array<int, 2>, 12> cell_edges{{{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
                                                          {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}}};
-
-/// The cell each node of a torn fine mesh is embedded in (paper 000 §2.2, Fig. 5: each side of
-/// the division follows the cells of its own piece): a kept cell of the node's piece (the piece
-/// of the tetrahedra that use it, TornTetMesh::piece) whose closed box holds the node's rest
-/// position; −1 when there is none (the node keeps its rest position). split_tet_mesh's own
-/// host_cell is kept when it satisfies this; it gives each node the cell of the centroid of the
-/// first tetrahedron that uses it, which for a node on a cell face, edge or corner can be a
-/// neighbouring cell that does not hold the node, and NetworkEmbedding leaves such a node at
-/// rest (behind its moved piece, as a spike). Allocates.
-std::vector<int> torn_host_cells(const TornTetMesh& torn, const SpringNetwork& net) {
-  std::vector<int> parent(static_cast<std::size_t>(net.node_capacity())), label(static_cast<std::size_t>(net.cell_count()));
-  network_pieces(net, parent, label);
-  const auto nodes = static_cast<std::size_t>(torn.mesh.nodes.rows());
-  std::vector<int> piece(nodes, -1);
-  for (Eigen::Index t = 0; t < torn.mesh.tets.rows(); ++t)
-    for (int k = 0; k < 4; ++k) piece[static_cast<std::size_t>(torn.mesh.tets(t, k))] = torn.piece[static_cast<std::size_t>(t)];
-  const double h = net.block.cell_size;
-  const double eps = 1e-9; // in cell widths, NetworkEmbedding's tolerance
-  const auto holds = [&](int cell, const Eigen::Vector3d& q) {
-    const Eigen::Vector3d xi = q - net.cell_index[static_cast<std::size_t>(cell)].cast<double>();
-    return (xi.array() >= -eps).all() && (xi.array() <= 1.0 + eps).all();
-  };
-  std::vector<int> host(nodes, -1);
-  for (std::size_t p = 0; p < nodes; ++p) {
-    const Eigen::Vector3d q = (torn.mesh.nodes.row(static_cast<Eigen::Index>(p)).transpose() - net.block.origin) / h;
-    const int given = torn.host_cell[p];
-    if (given >= 0 && label[static_cast<std::size_t>(given)] == piece[p] && holds(given, q)) {
-      host[p] = given;
-      continue;
-    }
-    // The up to 8 cells whose closed boxes hold q: q's own, and across each face it lies on.
-    const Eigen::Vector3i base = q.array().floor().cast<int>();
-    for (int k = 0; k < 8 && host[p] < 0; ++k) {
-      Eigen::Vector3i g = base;
-      bool on_faces = true;
-      for (int i = 0; i < 3; ++i)
-        if ((k >> i) & 1) {
-          if (q[i] - base[i] < eps) g[i] -= 1;
-          else on_faces = false;
-        }
-      if (!on_faces) continue;
-      const int c = net.cell_at_index(g);
-      if (c >= 0 && label[static_cast<std::size_t>(c)] == piece[p] && holds(c, q)) host[p] = c;
-    }
-  }
-  return host;
-}
 
 } // namespace
 
@@ -106,10 +58,10 @@ void SpringsAdapter::rebuild_body(const ModelState& state) {
   } else {
     // Paper 000 §2.2, Fig. 5: the fine tetrahedra are divided along the exposed cell faces and
     // each side is embedded in the cells of its own piece.
+    // Each node is embedded in a kept cell of its own piece that holds it (TornTetMesh::host_cell).
     TornTetMesh torn = split_tet_mesh(m_mesh, m_net);
-    const std::vector<int> host = torn_host_cells(torn, m_net);
     m_body = std::move(torn.mesh);
-    m_embedding = std::make_unique<NetworkEmbedding>(m_net, m_body.nodes, EmbeddingScheme::coons, &host);
+    m_embedding = std::make_unique<NetworkEmbedding>(m_net, m_body.nodes, EmbeddingScheme::coons, &torn.host_cell);
   }
   m_topology = state.topology;
 }

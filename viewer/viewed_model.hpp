@@ -40,6 +40,13 @@ public:
   /// Wall time of the longest snapshot so far [s] (the cost the view adds to one step).
   [[nodiscard]] double max_capture_seconds() const noexcept { return m_max_capture; }
   [[nodiscard]] std::uint64_t frames_published() const noexcept { return m_sequence; }
+  /// Snapshots during which the stepping thread gave up its CPU voluntarily (getrusage
+  /// RUSAGE_THREAD: its voluntary context switches across capture and publish), i.e. waited for
+  /// something: a lock, a page brought in, a system call that sleeps. The snapshot only copies
+  /// numbers into a slot of a wait-free triple buffer, so this stays 0 whatever the render thread
+  /// does; a snapshot that waited on the render side would show here. (Being preempted is not
+  /// waiting: involuntary switches are the machine's, not counted.)
+  [[nodiscard]] std::uint64_t blocked_snapshots() const noexcept { return m_blocked; }
 
 private:
   ToolModel& m_model;
@@ -49,6 +56,7 @@ private:
   double m_next = 0.0;
   std::uint64_t m_sequence = 0;
   double m_max_capture = 0.0;
+  std::uint64_t m_blocked = 0;
   const TimingStatistics* m_timing = nullptr;
   std::array<ToolState, max_session_tools> m_last_tools{};
   std::array<ForceSample, max_session_tools> m_last_forces{};

@@ -134,11 +134,13 @@ void scene_screenshot(const ViewOptions& o, const Scene& scene, const TetMesh& m
       view.extend_bounds(s.position + Eigen::Vector3d::Constant(r));
     }
   }
-  frame_camera(window.camera(), view.bounds(), parse_camera(o.camera), window.body_aspect());
   const double at = o.at >= 0.0 ? o.at : 0.0;
   const std::array<double, 1> times{at};
   step_through(viewed, trajectories, times, [&](const ViewFrame& f) { view.show(f); },
                [&](double force) { view.note_force(force); });
+  // The camera frames the body as shown too (torn pieces carried beyond the rest block).
+  for (Eigen::Index i = 0; i < view.shown().points.rows(); ++i) view.extend_bounds(view.shown().points.row(i).transpose());
+  frame_camera(window.camera(), view.bounds(), parse_camera(o.camera), window.body_aspect());
   window.write_png(o.screenshot);
   std::printf("wrote %s (%s / %s at t = %.4f s)\n", o.screenshot.c_str(), scene.name.c_str(), o.model.c_str(), at);
 }
@@ -223,12 +225,18 @@ void scene_live(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, B
               report.servo.realtime.fifo ? " (SCHED_FIFO)" : "");
   std::printf("  whole tick     p50 %8.2f us  p99 %8.2f us  max %8.2f us\n", t.tick.percentile(50) * 1e6,
               t.tick.percentile(99) * 1e6, t.tick.max() * 1e6);
+  // Woken after the deadline (the scheduler's latency): a tick overruns when this plus its work
+  // passes the next deadline.
+  std::printf("  woken late     p50 %8.2f us  p99 %8.2f us  max %8.2f us\n", t.lateness.percentile(50) * 1e6,
+              t.lateness.percentile(99) * 1e6, t.lateness.max() * 1e6);
   if (o.no_view) std::printf("view: off (--no-view)\n");
   else
-    std::printf("view: %llu snapshots (longest %.2f us in the %s thread), %llu frames drawn (mean %.2f ms, max %.2f ms)\n",
+    std::printf("view: %llu snapshots (longest %.2f us in the %s thread, %llu waited), %llu frames drawn (mean %.2f ms, "
+                "max %.2f ms)\n",
                 static_cast<unsigned long long>(report.frames_published), report.max_capture_seconds * 1e6,
-                o.model_rate > 0.0 ? "model" : "servo", static_cast<unsigned long long>(report.frames_rendered),
-                report.mean_render_seconds * 1e3, report.max_render_seconds * 1e3);
+                o.model_rate > 0.0 ? "model" : "servo", static_cast<unsigned long long>(report.blocked_snapshots),
+                static_cast<unsigned long long>(report.frames_rendered), report.mean_render_seconds * 1e3,
+                report.max_render_seconds * 1e3);
   if (!o.screenshot.empty()) std::printf("wrote %s\n", o.screenshot.c_str());
 }
 

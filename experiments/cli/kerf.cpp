@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   kerf::cli::add_calibrate_command(app);
   kerf::cli::add_recommend_command(app);
   kerf::cli::add_reference_command(app);
+  kerf::cli::add_view_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

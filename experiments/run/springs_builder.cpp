@@ -51,8 +51,9 @@ public:
 
   /// DIR/springs.pvd and DIR/springs/frame_NNNN.vtu: the fine mesh, split along the network's
   /// pieces (split_tet_mesh) and moved by the trilinear embedding of each recorded frame, the
-  /// last frame being the state after the last step; point data `displacement` [m], cell data
-  /// `piece`. Returns the manifest's "fields" entry.
+  /// last frame being the state after the last step; the points are the moved mesh (the
+  /// manifest's fields.points = "deformed"), point data `displacement` = moved − rest [m], cell
+  /// data `piece`. Returns the manifest's "fields" entry.
   nlohmann::json write_series(const TetMesh& mesh, const std::filesystem::path& dir) {
     std::vector<const Frame*> frames;
     for (std::size_t k = 0; k < m_used; ++k) frames.push_back(&m_frames[k]);
@@ -100,6 +101,7 @@ public:
     });
     nlohmann::json j;
     j["series"] = "springs.pvd";
+    j["points"] = "deformed"; // the .vtu points are the moved mesh; "displacement" = moved − rest
     j["frames"] = files.size();
     j["frame_interval_s"] = m_interval;
     j["embedding"] = "trilinear";

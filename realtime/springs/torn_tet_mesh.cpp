@@ -84,20 +84,20 @@ TornTetMesh split_tet_mesh(const TetMesh& mesh, const SpringNetwork& net) {
   std::vector<Eigen::Vector3d> nodes;
   std::vector<Eigen::Vector4i> tets;
   const double quantum = 1e-9 * h;
-  // The host of a node of `piece`: a kept cell of that piece containing the point (a point on a
-  // cell face, edge or corner lies in up to 8 cells: the first of the piece), or −1.
+  // The host of a node of `piece`: a kept cell of that piece whose closed box holds the point
+  // (to 1e-9 cell widths), or −1. A point on a cell face, edge or corner lies in up to 8 cells, on
+  // either side of each face: its own cell and the neighbours across the faces it lies on, which
+  // may be above as well as below (0.035 m / 0.005 m rounds to just under 7: the cell above the
+  // face x = 35 mm holds the point too). Own cell first, then the others.
   const auto host_of = [&](const Eigen::Vector3d& p, int piece) {
+    constexpr std::array<int, 3> offset{0, -1, 1};
     const Eigen::Vector3d q = grid(p);
     const Eigen::Vector3i base = q.array().floor().cast<int>();
-    for (int k = 0; k < 8; ++k) {
-      Eigen::Vector3i g = base;
-      bool valid = true;
-      for (int i = 0; i < 3; ++i)
-        if ((k >> i) & 1) {
-          if (q[i] - base[i] < 1e-9) g[i] -= 1;
-          else valid = false;
-        }
-      if (!valid) continue;
+    for (int k = 0; k < 27; ++k) {
+      const Eigen::Vector3i g = base + Eigen::Vector3i(offset[static_cast<std::size_t>(k % 3)], offset[static_cast<std::size_t>((k / 3) % 3)],
+                                                       offset[static_cast<std::size_t>(k / 9)]);
+      const Eigen::Vector3d xi = q - g.cast<double>();
+      if ((xi.array() < -1e-9).any() || (xi.array() > 1.0 + 1e-9).any()) continue;
       if (const int c = net.cell_at_index(g); c >= 0 && label[static_cast<std::size_t>(c)] == piece) return c;
     }
     return -1;

@@ -73,14 +73,26 @@ LiveViewReport session(const std::string& scene_name, const std::string& model_n
   return run_live_view(*built.model, built.core_model(), mesh, raw, s);
 }
 
-/// The overrun counter with and without the view, in up to three attempts (a machine shared by
-/// others can miss a deadline by itself: a CPU-quota throttle or a neighbour's interrupt is no
-/// fault of the view). Passes on the first attempt whose sessions both have zero overruns; fails
-/// if the sessions without the view keep zero while those with it do not; is skipped, saying so,
-/// if the servo misses deadlines even without the view in every attempt.
+/// The overrun counter with and without the view, in pairs of sessions (without, then with).
+///
+/// What can make the servo miss a deadline here is mostly the machine: a SCHED_FIFO thread that
+/// does nothing but sleep to 1 kHz deadlines is woken more than 0.8 ms late 1-6 times in every
+/// 2 s at a load of 6 on this machine's 2 virtual CPUs (guest kernel PREEMPT_NONE: a task in a
+/// long system call keeps its CPU until it leaves the kernel; and the hypervisor's steal), so
+/// the view-less sessions miss deadlines as often as the viewed ones (8 pairs: 5 of 8 against 4
+/// of 8; docs/viewer.md). The view's own way of delaying the servo — making the stepping thread
+/// wait — is measured directly, in every viewed session: no snapshot may wait
+/// (ViewedModel::blocked_snapshots, the thread's voluntary context switches across it).
+///
+/// The counter itself: passes on the first pair whose sessions both miss nothing (the issue's
+/// check); fails if in every attempt the session without the view missed nothing while the one
+/// with it missed deadlines (a machine that holds its deadlines, a view that breaks them); is
+/// skipped, saying so, when the sessions without the view missed deadlines too: the machine
+/// cannot hold them, and the pairs cannot tell the view's misses from its own.
 void expect_no_overrun(const std::string& scene, const std::string& model, double model_rate) {
-  int baseline_clean = 0;
-  for (int attempt = 1; attempt <= 3; ++attempt) {
+  constexpr int attempts = 5;
+  int baseline_missed = 0;
+  for (int attempt = 1; attempt <= attempts; ++attempt) {
     const LiveViewReport off = session(scene, model, model_rate, false);
     const LiveViewReport on = session(scene, model, model_rate, true);
     ASSERT_GT(off.servo.timing.ticks, 1400u);
@@ -88,19 +100,25 @@ void expect_no_overrun(const std::string& scene, const std::string& model, doubl
     // The view did run beside the loop: frames were snapshot and drawn.
     EXPECT_GT(on.frames_published, 5u);
     EXPECT_GT(on.frames_rendered, 1u);
-    std::printf("attempt %d, %s/%s: overruns %llu without the view, %llu with it; servo tick max %.1f us / %.1f us; "
-                "snapshot max %.1f us; %llu frames drawn, mean %.2f ms; SCHED_FIFO %s\n",
+    // The stepping thread never waited in a snapshot (the render thread drew meanwhile).
+    EXPECT_EQ(on.blocked_snapshots, 0u) << "a snapshot waited: the view blocked the thread that steps the model";
+    std::printf("attempt %d, %s/%s: overruns %llu without the view, %llu with it; woken late at most %.1f us / %.1f us; "
+                "servo tick max %.1f us / %.1f us; snapshot max %.1f us, %llu waited; %llu frames drawn, mean %.2f ms; "
+                "SCHED_FIFO %s\n",
                 attempt, scene.c_str(), model.c_str(), static_cast<unsigned long long>(off.servo.timing.overruns),
-                static_cast<unsigned long long>(on.servo.timing.overruns), off.servo.timing.tick.max() * 1e6,
+                static_cast<unsigned long long>(on.servo.timing.overruns), off.servo.timing.lateness.max() * 1e6,
+                on.servo.timing.lateness.max() * 1e6, off.servo.timing.tick.max() * 1e6,
                 on.servo.timing.tick.max() * 1e6, on.max_capture_seconds * 1e6,
-                static_cast<unsigned long long>(on.frames_rendered), on.mean_render_seconds * 1e3,
-                on.servo.realtime.fifo ? "yes" : "no");
+                static_cast<unsigned long long>(on.blocked_snapshots), static_cast<unsigned long long>(on.frames_rendered),
+                on.mean_render_seconds * 1e3, on.servo.realtime.fifo ? "yes" : "no");
     if (off.servo.timing.overruns == 0 && on.servo.timing.overruns == 0) return; // zero with and without the view
-    if (off.servo.timing.overruns == 0) ++baseline_clean;
+    if (off.servo.timing.overruns > 0) ++baseline_missed;
   }
-  if (baseline_clean == 0) GTEST_SKIP() << "the servo loop missed deadlines without the view in every attempt: this "
-                                           "machine cannot hold the deadline, so the view cannot be judged here";
-  FAIL() << "with the view the servo loop missed deadlines in attempts where it missed none without it";
+  if (baseline_missed > 0)
+    GTEST_SKIP() << "the servo loop missed deadlines without the view in " << baseline_missed << " of " << attempts
+                 << " attempts: this machine cannot hold the deadline, so the overrun counter cannot judge the view "
+                    "here (no snapshot waited)";
+  FAIL() << "with the view the servo loop missed deadlines in every attempt, without it in none";
 }
 
 } // namespace

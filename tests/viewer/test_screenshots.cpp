@@ -153,8 +153,12 @@ TEST(ViewerScreenshot, ClayPullChangesOnlyWhereTheBodyDeforms) {
 // rest one run; torn and pulled apart two, separated by a gap of empty columns centred within
 // 1.5 cells (7.5 mm) of the mid-plane (this model tears at the face x = 35 mm: the gap's centre
 // in the rest frame is the tear's position). The gap is as wide as the pieces moved apart: each
-// follows its stylus, 10 mm out (the scene's trajectories), 20 mm in all for a plane tear, down
-// to 15 mm if the tear steps by one cell across the section.
+// follows its stylus, 10 mm out at t = 3 s (the scene's trajectories: 10 mm at 5 mm/s, then a
+// 1 s hold in which the pieces' recoil is damped out), 20 mm in all for a plane tear, down to
+// 15 mm if the tear steps by one cell across the section; never wider than 20 mm, up to one
+// pixel at each side of the gap (silhouette rasterisation). (A series read with its moved points
+// moved by the displacement again showed 27.6 mm: each piece 20 mm out, and spikes back to the
+// tear from nodes the series had left at rest.)
 TEST(ViewerScreenshot, TornClayShowsTwoFragmentsAlongTheTearLine) {
   const auto run = scratch("clay_tear_springs");
   auto [code, out] = run_kerf("run clay_tear --model springs -o " + run.string());
@@ -198,7 +202,7 @@ TEST(ViewerScreenshot, TornClayShowsTwoFragmentsAlongTheTearLine) {
   EXPECT_NEAR(gap_centre, 0.030, 0.0075) << "the gap should lie on the tear line x = 30 mm";
   const double gap_width = (runs[1].first - runs[0].second - 1) / f.pixels_per_metre;
   EXPECT_GT(gap_width, 0.015) << "the pieces should be 20 mm apart";
-  EXPECT_LT(gap_width, 0.0205) << "the pieces should be 20 mm apart";
+  EXPECT_LE(gap_width, 0.020 + 2.0 / f.pixels_per_metre) << "the pieces should be 20 mm apart";
 }
 
 // kerf view RUN RUN: the same run side by side must give the same picture in both halves (one

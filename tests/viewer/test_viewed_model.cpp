@@ -17,7 +17,11 @@
 #include <gtest/gtest.h>
 #include <vtkDataSet.h>
 
+#include <atomic>
+#include <chrono>
 #include <fstream>
+#include <mutex>
+#include <thread>
 #include <unistd.h>
 
 using namespace kerf;
@@ -58,6 +62,55 @@ TEST(ViewedModel, SnapshotIsTheModelStateAfterTheStep) {
   // One frame per 1/60 s of model time: 400 ms at 1 kHz gives one every 17 ms (the first step
   // publishes at once), 24 in all.
   EXPECT_EQ(taken, 24u);
+}
+
+/// An adapter whose snapshot takes a lock the render side may hold (what the triple buffer
+/// avoids): the springs adapter's capture under `lock`.
+class LockingAdapter final : public ModelAdapter {
+public:
+  LockingAdapter(ModelAdapter& inner, std::mutex& lock) : m_inner(inner), m_lock(lock) {}
+  void reserve(ModelState& state) const override { m_inner.reserve(state); }
+  void capture(ModelState& state) const noexcept override {
+    const std::lock_guard<std::mutex> hold(m_lock);
+    m_inner.capture(state);
+  }
+  void geometry(const ViewFrame& frame, BodyGeometry& out) override { m_inner.geometry(frame, out); }
+  [[nodiscard]] std::string_view overlay_name() const override { return m_inner.overlay_name(); }
+
+private:
+  ModelAdapter& m_inner;
+  std::mutex& m_lock;
+};
+
+// The count the live view's test relies on (ViewedModel::blocked_snapshots): a snapshot that
+// only copies into the wait-free triple buffer never waits, while one that needs a lock held
+// elsewhere (here by a "render" thread for 20 ms) waits and is counted — the thread's voluntary
+// context switch, whatever the machine's load.
+TEST(ViewedModel, ASnapshotThatWaitsIsCounted) {
+  ClayPull c;
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(c.model, c.mesh);
+  std::vector<ForceSample> forces(1);
+  const double dt = 1.0 / c.trajectory[0].rate;
+  {
+    ViewedModel viewed(c.model, *adapter, dt); // a snapshot at every step
+    for (std::size_t k = 0; k < 200; ++k) viewed.step(std::span(&c.trajectory[0].samples[k], 1), dt, forces);
+    EXPECT_EQ(viewed.frames_published(), 200u);
+    EXPECT_EQ(viewed.blocked_snapshots(), 0u);
+  }
+  std::mutex lock;
+  LockingAdapter locking(*adapter, lock);
+  ViewedModel viewed(c.model, locking, dt);
+  std::atomic<bool> held{false};
+  std::thread render([&] {
+    const std::lock_guard<std::mutex> hold(lock);
+    held.store(true);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  });
+  while (!held.load()) std::this_thread::yield();
+  viewed.step(std::span(&c.trajectory[0].samples[0], 1), dt, forces); // waits for the render thread
+  render.join();
+  EXPECT_EQ(viewed.frames_published(), 1u);
+  EXPECT_EQ(viewed.blocked_snapshots(), 1u);
 }
 
 // Paper 000 §2.1: the fine mesh follows the network by interpolation inside the network's cells
@@ -163,8 +216,9 @@ TEST(ModelAdapter, EachCatalogueModelIsReadByItsOwnAdapter) {
 }
 
 // A .pvd written like the reference's (kerf's VTU writer, a displacement field, steps listed
-// out of order) reads back sorted, with points moved by exactly the displacement.
-TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {
+// out of order) reads back sorted, with points moved by exactly the displacement; the same
+// files read as a series of deformed positions keep their points as written.
+TEST(PvdSeries, ReadsStepsAtTheirDeformedPositions) {
   const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_pvd_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir / "fields");
   TetMesh mesh;
@@ -184,7 +238,8 @@ TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {
            "<DataSet timestep=\"2.5\" file=\"fields/step_1.vtu\"/>\n<DataSet timestep=\"0\" file=\"fields/step_0.vtu\"/>\n"
            "</Collection>\n</VTKFile>\n";
   }
-  PvdSeries series(dir / "fields.pvd");
+  // Written at rest positions (as the reference's fields.pvd): shown at X + u.
+  PvdSeries series(dir / "fields.pvd", SeriesPoints::rest);
   ASSERT_EQ(series.times().size(), 2u);
   EXPECT_EQ(series.times()[0], 0.0);
   EXPECT_EQ(series.times()[1], 2.5);
@@ -198,6 +253,16 @@ TEST(PvdSeries, ReadsStepsAndWarpsByDisplacement) {
     moved->GetPoint(i, p);
     EXPECT_DOUBLE_EQ(p[2], mesh.nodes(i, 2) + 0.5);
   }
-  EXPECT_THROW(PvdSeries(dir / "missing.pvd"), std::runtime_error);
+  // The same files read as a series of deformed positions (as the spring network's springs.pvd
+  // writes them): shown where they are, not moved by u a second time.
+  PvdSeries as_written(dir / "fields.pvd", SeriesPoints::deformed);
+  vtkDataSet* kept = as_written.deformed(1);
+  ASSERT_EQ(kept->GetNumberOfPoints(), 4);
+  for (vtkIdType i = 0; i < 4; ++i) {
+    double p[3];
+    kept->GetPoint(i, p);
+    EXPECT_DOUBLE_EQ(p[2], mesh.nodes(i, 2));
+  }
+  EXPECT_THROW(PvdSeries(dir / "missing.pvd", SeriesPoints::rest), std::runtime_error);
   std::filesystem::remove_all(dir);
 }
