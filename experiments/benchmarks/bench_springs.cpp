@@ -7,6 +7,8 @@
 #include "meshes/box_tet_mesh.hpp"
 #include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/network_embedding.hpp"
+#include "realtime/springs/network_system.hpp"
+#include "realtime/springs/symplectic_euler.hpp"
 #include "realtime/springs/spring_network_model.hpp"
 
 #include <benchmark/benchmark.h>
@@ -81,6 +83,56 @@ void force_cost(benchmark::State& state, bool lattice) {
   state.counters["springs"] = net.springs.count;
 }
 
+/// A full N^3 clay block (2.5 mm cells, damped) with its base (z = 0) fixed: the implicit step's
+/// system without the stylus.
+SpringNetwork clay_block(int n) {
+  const double h = 2.5e-3;
+  NetworkBlock block;
+  block.cell_size = h;
+  block.cells = Eigen::Vector3i::Constant(n);
+  SpringNetwork net = build_spring_network(block, std::vector<bool>(static_cast<std::size_t>(n * n * n), true),
+                                           identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0, 2e-5);
+  for (int q = 0; q < net.node_count; ++q)
+    if (net.rest(2, q) < 1e-9) net.constraint[static_cast<std::size_t>(q)] = fix_all;
+  return net;
+}
+
+/// The pieces of one implicit Euler step (1 ms) on a full N^3 clay block: `solve` one pair of
+/// triangular solves with the kept factor (single precision, as the implicit integrator reads
+/// it; `solve_double` the double-precision factor the quasi-static integrator reads),
+/// `factorize` one assembly and numeric factorisation.
+void system_cost(benchmark::State& state, bool factorize, NetworkSystem::SolvePrecision precision) {
+  const SpringNetwork net = clay_block(static_cast<int>(state.range(0)));
+  NetworkSystem system(precision);
+  system.rebuild(net);
+  const double dt = 1e-3;
+  system.assemble(net, net.rest, 1.0 / (dt * dt), 1.0 + net.damping_time / dt);
+  if (!system.factorize()) state.SkipWithError("factorisation failed");
+  Eigen::VectorXd rhs(system.dof_count()), out(system.dof_count());
+  for (int k = 0; k < rhs.size(); ++k) rhs[k] = std::sin(0.37 * k);
+  for (auto _ : state) {
+    if (factorize) {
+      system.assemble(net, net.rest, 1.0 / (dt * dt), 1.0 + net.damping_time / dt);
+      benchmark::DoNotOptimize(system.factorize());
+    } else {
+      system.solve(rhs, out);
+    }
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["dofs"] = system.dof_count();
+  state.counters["factor_entries"] = system.factor_entries();
+}
+
+/// The explicit integrator's per-sample Gershgorin bound on the deformed tangent (the sub-step
+/// shortening of SpringNetworkModel) on a full N^3 clay block.
+void gershgorin_cost(benchmark::State& state) {
+  const SpringNetwork net = clay_block(static_cast<int>(state.range(0)));
+  Eigen::Matrix3Xd x = net.rest;
+  for (int q = 0; q < net.node_count; ++q) x(2, q) += 1e-4 * std::sin(x(0, q) * 400.0);
+  std::vector<double> work(static_cast<std::size_t>(net.node_capacity()));
+  for (auto _ : state) benchmark::DoNotOptimize(gershgorin_frequency_bound(net, x, work));
+}
+
 void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
   const int n = 8;
   const double h = 2.5e-3;
@@ -113,6 +165,10 @@ BENCHMARK_CAPTURE(step_cost, explicit_peer, SpringIntegrator::symplectic_euler, 
 BENCHMARK_CAPTURE(step_cost, implicit_peer, SpringIntegrator::implicit_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(system_cost, solve, false, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(system_cost, solve_double, false, NetworkSystem::SolvePrecision::double_precision)->Arg(8)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(system_cost, factorize, true, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK(gershgorin_cost)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(embedding_cost, trilinear, EmbeddingScheme::trilinear)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, coons, EmbeddingScheme::coons)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 

@@ -15,9 +15,6 @@ constexpr std::array<std::array<int, 3>, 13> directions{{{1, 0, 0},  {0, 1, 0}, 
                                                          {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}, {1, 1, 1},
                                                          {1, 1, -1}, {1, -1, 1}, {1, -1, -1}}};
 
-/// Local corner a's sign along axis i, s_a[i] ∈ {−1, +1} (corner a = bx + 2 by + 4 bz).
-constexpr double corner_sign(int a, int i) { return ((a >> i) & 1) ? 1.0 : -1.0; }
-
 /// The springs of one lattice direction, from lattice points p in [begin, end) to p + o: adds
 /// each spring's force on its start point to F and stores it in G (the end point takes −G).
 /// Returns their elastic energy [J].
@@ -106,21 +103,25 @@ double cell_volumes(int end, const int* corner, double c, double kappa_v0, doubl
 }
 
 /// F_r[q] −= Σ_a Σ_i s_a[i] Q_{i r}[pad + q − o_a] for lattice points q in [0, points): each
-/// point collects the volume forces of the (up to 8) cells it is a corner of.
+/// point collects the volume forces of the (up to 8) cells it is a corner of, in one pass per
+/// row r (24 reads, one update of F_r per point).
 KERF_VECTOR_CLONES
 void cell_volume_forces(int points, const int* corner, const double* __restrict Q, int stride, int pad,
                         double* __restrict FX, double* __restrict FY, double* __restrict FZ) {
   double* F[3] = {FX, FY, FZ};
+  const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
   for (int r = 0; r < 3; ++r) {
-    const double* __restrict Q0 = Q + r * stride + pad;
-    const double* __restrict Q1 = Q + (3 + r) * stride + pad;
-    const double* __restrict Q2 = Q + (6 + r) * stride + pad;
+    const double* __restrict A = Q + r * stride + pad;       // Q_0r: the s_a[0] column
+    const double* __restrict B = Q + (3 + r) * stride + pad; // Q_1r
+    const double* __restrict C = Q + (6 + r) * stride + pad; // Q_2r
     double* __restrict Fr = F[r];
-    for (int a = 0; a < 8; ++a) {
-      const int o = corner[a];
-      const double s0 = corner_sign(a, 0), s1 = corner_sign(a, 1), s2 = corner_sign(a, 2);
 #pragma omp simd
-      for (int q = 0; q < points; ++q) Fr[q] -= s0 * Q0[q - o] + s1 * Q1[q - o] + s2 * Q2[q - o];
+    for (int q = 0; q < points; ++q) {
+      // Σ_a (s_a[0] A + s_a[1] B + s_a[2] C)[q − o_a], corner a = bx + 2 by + 4 bz, s = 2b − 1
+      const double a = (A[q - o1] - A[q]) + (A[q - o3] - A[q - o2]) + (A[q - o5] - A[q - o4]) + (A[q - o7] - A[q - o6]);
+      const double b = (B[q - o2] - B[q]) + (B[q - o3] - B[q - o1]) + (B[q - o6] - B[q - o4]) + (B[q - o7] - B[q - o5]);
+      const double c = (C[q - o4] - C[q]) + (C[q - o5] - C[q - o1]) + (C[q - o6] - C[q - o2]) + (C[q - o7] - C[q - o3]);
+      Fr[q] -= a + b + c;
     }
   }
 }

@@ -106,6 +106,8 @@ private:
   SolvePrecision m_precision;
   std::vector<float> m_factor_single;  ///< single-precision copy of L's values (single_precision)
   std::vector<double> m_below;         ///< solve workspace: the rows below one supernode
+  std::vector<double> m_dots;          ///< solve workspace: one supernode's column dot products
+  std::vector<double> m_inverse_diagonal; ///< 1 / L_kk of the last factorisation
   std::vector<double> m_update_buffer; ///< CHOLMOD's supernode update workspace (see factorize)
   bool m_factorized = false;
 };
