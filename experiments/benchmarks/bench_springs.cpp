@@ -124,13 +124,15 @@ void system_cost(benchmark::State& state, bool factorize, NetworkSystem::SolvePr
 }
 
 /// The explicit integrator's per-sample Gershgorin bound on the deformed tangent (the sub-step
-/// shortening of SpringNetworkModel) on a full N^3 clay block.
-void gershgorin_cost(benchmark::State& state) {
+/// shortening of SpringNetworkModel) on a full N^3 clay block: over the merged flat spring
+/// arrays and per cell (gershgorin_frequency_bound, used after a tear) or on the lattice.
+void gershgorin_cost(benchmark::State& state, bool lattice) {
   const SpringNetwork net = clay_block(static_cast<int>(state.range(0)));
   Eigen::Matrix3Xd x = net.rest;
   for (int q = 0; q < net.node_count; ++q) x(2, q) += 1e-4 * std::sin(x(0, q) * 400.0);
   std::vector<double> work(static_cast<std::size_t>(net.node_capacity()));
-  for (auto _ : state) benchmark::DoNotOptimize(gershgorin_frequency_bound(net, x, work));
+  LatticeForces forces(net);
+  for (auto _ : state) benchmark::DoNotOptimize(lattice ? forces.gershgorin_bound(net, x) : gershgorin_frequency_bound(net, x, work));
 }
 
 void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
@@ -168,7 +170,8 @@ BENCHMARK_CAPTURE(force_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchma
 BENCHMARK_CAPTURE(system_cost, solve, false, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(system_cost, solve_double, false, NetworkSystem::SolvePrecision::double_precision)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(system_cost, factorize, true, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
-BENCHMARK(gershgorin_cost)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(gershgorin_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(gershgorin_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(embedding_cost, trilinear, EmbeddingScheme::trilinear)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, coons, EmbeddingScheme::coons)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 
