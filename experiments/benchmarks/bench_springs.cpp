@@ -14,6 +14,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <ctime>
 #include <random>
 
 namespace {
@@ -135,6 +136,74 @@ void gershgorin_cost(benchmark::State& state, bool lattice) {
   for (auto _ : state) benchmark::DoNotOptimize(lattice ? forces.gershgorin_bound(net, x) : gershgorin_frequency_bound(net, x, work));
 }
 
+/// CPU time of the calling thread [s] (the per-sample cost of the tear storm, on a shared machine).
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// A tear storm: clay_tear (experiments/scenes/clay_tear.toml) on a 24 x 8 x 8 box mesh of the
+/// 60 x 20 x 20 mm bar, as tests/realtime/springs/test_tearing.cpp sets it up (12 cells per side,
+/// h = 5 mm, styluses grasping the nodes within 7.5 mm, pulled apart at 5 mm/s each, tensile
+/// limit 50 kPa), 1 ms samples until 50 samples past the rupture (the vertex splits come one per
+/// sample, many in consecutive samples). Each sample's CPU time is taken alone; counters: the
+/// splits, the samples, the median, p99 and largest sample cost, the largest cost of a sample
+/// that split a vertex and of the sample after one (where the implicit and quasi-static
+/// integrators refactorise on the kept tear-ready pattern), and the samples over 1 ms.
+void tear_storm(benchmark::State& state, SpringIntegrator integrator) {
+  const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.06, 0.01, 0.02}, 24, 8, 8);
+  SpringNetworkSetup s;
+  s.youngs_modulus = 0.5e6;
+  s.poisson_ratio = 0.45;
+  s.density = 1700.0;
+  s.damping = 10.0;
+  s.integrator = integrator;
+  s.supports = {{"support", true}};
+  s.styluses = {{Eigen::Vector3d(0.015, 0.0, 0.022), 0.002}, {Eigen::Vector3d(0.045, 0.0, 0.022), 0.002}};
+  s.cells = 12;
+  s.grasp_radius = 0.0075;
+  s.tearing = true;
+  s.tensile_limit = 50e3;
+  SpringNetworkModel model(mesh, s);
+  std::vector<double> cost, tearing, after;
+  cost.reserve(2200);
+  for (auto _ : state) {
+    model.reset();
+    cost.clear(), tearing.clear(), after.clear();
+    std::array<ToolState, 2> tools;
+    std::array<ForceSample, 2> forces;
+    int rupture = -1;
+    bool split_before = false;
+    for (int k = 0; k <= 2000 && (rupture < 0 || k <= rupture + 50); ++k) {
+      const double d = 5e-6 * k;
+      tools[0].position = {0.015 - d, 0.0, 0.022};
+      tools[1].position = {0.045 + d, 0.0, 0.022};
+      const int tears = model.tears();
+      const double t0 = thread_seconds();
+      model.step(tools, 1e-3, forces);
+      const double c = thread_seconds() - t0;
+      cost.push_back(c);
+      if (split_before) after.push_back(c);
+      split_before = model.tears() > tears;
+      if (split_before) tearing.push_back(c);
+      if (rupture < 0 && forces[0].mode == InteractionMode::rupture) rupture = k;
+    }
+    state.counters["rupture_sample"] = rupture;
+  }
+  const auto largest = [](const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
+  std::vector<double> sorted = cost;
+  std::sort(sorted.begin(), sorted.end());
+  state.counters["splits"] = model.tears();
+  state.counters["samples"] = static_cast<double>(cost.size());
+  state.counters["median_us"] = 1e6 * sorted[sorted.size() / 2];
+  state.counters["p99_us"] = 1e6 * sorted[std::min(sorted.size() - 1, sorted.size() * 99 / 100)];
+  state.counters["max_us"] = 1e6 * sorted.back();
+  state.counters["max_splitting_sample_us"] = 1e6 * largest(tearing);
+  state.counters["max_sample_after_split_us"] = 1e6 * largest(after);
+  state.counters["samples_over_1ms"] = static_cast<double>(std::count_if(cost.begin(), cost.end(), [](double c) { return c > 1e-3; }));
+}
+
 void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
   const int n = 8;
   const double h = 2.5e-3;
@@ -172,6 +241,9 @@ BENCHMARK_CAPTURE(system_cost, solve_double, false, NetworkSystem::SolvePrecisio
 BENCHMARK_CAPTURE(system_cost, factorize, true, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(gershgorin_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(gershgorin_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(tear_storm, implicit, SpringIntegrator::implicit_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tear_storm, static, SpringIntegrator::quasi_static)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tear_storm, explicit, SpringIntegrator::symplectic_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, trilinear, EmbeddingScheme::trilinear)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, coons, EmbeddingScheme::coons)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 
