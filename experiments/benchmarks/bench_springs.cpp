@@ -1,8 +1,11 @@
-// Cost of the spring network (paper 000 §2): one 1 ms servo sample against N (N^3 cells) for
-// each integrator (clay, and at 8^3 the peer setting), one force evaluation (the spring
-// loop against the lattice loops), and the embedding of 10^4 .. 10^6 fine nodes (trilinear and
-// Coons). Prefer the CPU-time column: the machine is shared.
-// Run: build/experiments/benchmarks/bench_springs --benchmark_min_time=0.2
+// Cost of the spring network (paper 000 §2): one servo sample against N (N^3 cells) for each
+// integrator at 1 kHz (clay, and at 8^3 the peer setting) and at 10 kHz; the pieces of a
+// sample (one force evaluation: the spring loop against the lattice loops; one pair of triangular
+// solves and one factorisation of the implicit system; the explicit integrator's Gershgorin
+// bound); a tear storm on clay_tear per integrator; and the embedding of 10^4 .. 10^6 fine nodes
+// (trilinear and Coons). Prefer the CPU-time column: the machine is shared.
+// Run: build/experiments/benchmarks/bench_springs --benchmark_min_time=0.3
+// (docs/spring-network.md §6 has the numbers and the load they were taken at.)
 
 #include "meshes/box_tet_mesh.hpp"
 #include "realtime/springs/lattice_forces.hpp"
@@ -14,6 +17,7 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <cmath>
 #include <ctime>
 #include <random>
 
@@ -34,8 +38,9 @@ constexpr BlockMaterial clay{0.5e6, 0.45, 1700.0, 10.0, 2.5e-3};
 constexpr BlockMaterial peer{50e3, 0.45, 1000.0, 1.0, 2e-3};
 
 /// A cube of side N cells whose whole volume is the network (cells = N), base bonded, a 2 mm
-/// stylus on the top centre moved up and down by 0.1 mm (period 200 samples), 1 ms samples.
-void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMaterial material) {
+/// stylus on the top centre moved up and down by 0.1 mm (period 0.2 s), samples of `dt` [s]
+/// (1 ms: a 1 kHz servo; 0.1 ms: 10 kHz).
+void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMaterial material, double dt = 1e-3) {
   const int n = static_cast<int>(state.range(0));
   const double side = material.cell_size * n;
   const TetMesh mesh = box_tet_mesh({0.0, 0.0, 0.0}, {side, side, side}, n, n, n);
@@ -52,10 +57,11 @@ void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMateri
   std::array<ToolState, 1> tool;
   std::array<ForceSample, 1> force;
   long k = 0;
+  const long period = std::lround(0.2 / dt);
   for (auto _ : state) {
-    const double phase = static_cast<double>(k++ % 200) / 200.0;
+    const double phase = static_cast<double>(k++ % period) / static_cast<double>(period);
     tool[0].position = s.styluses[0].start + Eigen::Vector3d(0, 0, 1e-4 * std::sin(6.283185307179586 * phase));
-    model.step(tool, 1e-3, force);
+    model.step(tool, dt, force);
     benchmark::DoNotOptimize(force[0].force.data());
   }
   state.counters["cells"] = model.network().cell_count();
@@ -232,6 +238,8 @@ void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
 BENCHMARK_CAPTURE(step_cost, explicit, SpringIntegrator::symplectic_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit, SpringIntegrator::implicit_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, static, SpringIntegrator::quasi_static, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, explicit_10kHz, SpringIntegrator::symplectic_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, implicit_10kHz, SpringIntegrator::implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_peer, SpringIntegrator::symplectic_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit_peer, SpringIntegrator::implicit_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
