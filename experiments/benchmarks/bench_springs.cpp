@@ -1,17 +1,24 @@
-// Cost of the spring network (paper 000 §2): one 1 ms servo sample against N (N^3 cells) for
-// each integrator (clay, and at 8^3 the peer setting), one force evaluation (the spring
-// loop against the lattice loops), and the embedding of 10^4 .. 10^6 fine nodes (trilinear and
-// Coons). Prefer the CPU-time column: the machine is shared.
-// Run: build/experiments/benchmarks/bench_springs --benchmark_min_time=0.2
+// Cost of the spring network (paper 000 §2): one servo sample against N (N^3 cells) for each
+// integrator at 1 kHz (clay, and at 8^3 the peer setting) and at 10 kHz; the pieces of a
+// sample (one force evaluation: the spring loop against the lattice loops; one pair of triangular
+// solves and one factorisation of the implicit system; the explicit integrator's Gershgorin
+// bound); a tear storm on clay_tear per integrator; and the embedding of 10^4 .. 10^6 fine nodes
+// (trilinear and Coons). Prefer the CPU-time column: the machine is shared.
+// Run: build/experiments/benchmarks/bench_springs --benchmark_min_time=0.3
+// (docs/spring-network.md §6 has the numbers and the load they were taken at.)
 
 #include "meshes/box_tet_mesh.hpp"
 #include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/network_embedding.hpp"
+#include "realtime/springs/network_system.hpp"
+#include "realtime/springs/symplectic_euler.hpp"
 #include "realtime/springs/spring_network_model.hpp"
 
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <cmath>
+#include <ctime>
 #include <random>
 
 namespace {
@@ -31,8 +38,9 @@ constexpr BlockMaterial clay{0.5e6, 0.45, 1700.0, 10.0, 2.5e-3};
 constexpr BlockMaterial peer{50e3, 0.45, 1000.0, 1.0, 2e-3};
 
 /// A cube of side N cells whose whole volume is the network (cells = N), base bonded, a 2 mm
-/// stylus on the top centre moved up and down by 0.1 mm (period 200 samples), 1 ms samples.
-void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMaterial material) {
+/// stylus on the top centre moved up and down by 0.1 mm (period 0.2 s), samples of `dt` [s]
+/// (1 ms: a 1 kHz servo; 0.1 ms: 10 kHz).
+void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMaterial material, double dt = 1e-3) {
   const int n = static_cast<int>(state.range(0));
   const double side = material.cell_size * n;
   const TetMesh mesh = box_tet_mesh({0.0, 0.0, 0.0}, {side, side, side}, n, n, n);
@@ -49,10 +57,11 @@ void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMateri
   std::array<ToolState, 1> tool;
   std::array<ForceSample, 1> force;
   long k = 0;
+  const long period = std::lround(0.2 / dt);
   for (auto _ : state) {
-    const double phase = static_cast<double>(k++ % 200) / 200.0;
+    const double phase = static_cast<double>(k++ % period) / static_cast<double>(period);
     tool[0].position = s.styluses[0].start + Eigen::Vector3d(0, 0, 1e-4 * std::sin(6.283185307179586 * phase));
-    model.step(tool, 1e-3, force);
+    model.step(tool, dt, force);
     benchmark::DoNotOptimize(force[0].force.data());
   }
   state.counters["cells"] = model.network().cell_count();
@@ -79,6 +88,126 @@ void force_cost(benchmark::State& state, bool lattice) {
     benchmark::DoNotOptimize(f.data());
   }
   state.counters["springs"] = net.springs.count;
+}
+
+/// A full N^3 clay block (2.5 mm cells, damped) with its base (z = 0) fixed: the implicit step's
+/// system without the stylus.
+SpringNetwork clay_block(int n) {
+  const double h = 2.5e-3;
+  NetworkBlock block;
+  block.cell_size = h;
+  block.cells = Eigen::Vector3i::Constant(n);
+  SpringNetwork net = build_spring_network(block, std::vector<bool>(static_cast<std::size_t>(n * n * n), true),
+                                           identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0, 2e-5);
+  for (int q = 0; q < net.node_count; ++q)
+    if (net.rest(2, q) < 1e-9) net.constraint[static_cast<std::size_t>(q)] = fix_all;
+  return net;
+}
+
+/// The pieces of one implicit Euler step (1 ms) on a full N^3 clay block: `solve` one pair of
+/// triangular solves with the kept factor (single precision, as the implicit integrator reads
+/// it; `solve_double` the double-precision factor the quasi-static integrator reads),
+/// `factorize` one assembly and numeric factorisation.
+void system_cost(benchmark::State& state, bool factorize, NetworkSystem::SolvePrecision precision) {
+  const SpringNetwork net = clay_block(static_cast<int>(state.range(0)));
+  NetworkSystem system(precision);
+  system.rebuild(net);
+  const double dt = 1e-3;
+  system.assemble(net, net.rest, 1.0 / (dt * dt), 1.0 + net.damping_time / dt);
+  if (!system.factorize()) state.SkipWithError("factorisation failed");
+  Eigen::VectorXd rhs(system.dof_count()), out(system.dof_count());
+  for (int k = 0; k < rhs.size(); ++k) rhs[k] = std::sin(0.37 * k);
+  for (auto _ : state) {
+    if (factorize) {
+      system.assemble(net, net.rest, 1.0 / (dt * dt), 1.0 + net.damping_time / dt);
+      benchmark::DoNotOptimize(system.factorize());
+    } else {
+      system.solve(rhs, out);
+    }
+    benchmark::DoNotOptimize(out.data());
+  }
+  state.counters["dofs"] = system.dof_count();
+  state.counters["factor_entries"] = system.factor_entries();
+}
+
+/// The explicit integrator's per-sample Gershgorin bound on the deformed tangent (the sub-step
+/// shortening of SpringNetworkModel) on a full N^3 clay block: over the merged flat spring
+/// arrays and per cell (gershgorin_frequency_bound, used after a tear) or on the lattice.
+void gershgorin_cost(benchmark::State& state, bool lattice) {
+  const SpringNetwork net = clay_block(static_cast<int>(state.range(0)));
+  Eigen::Matrix3Xd x = net.rest;
+  for (int q = 0; q < net.node_count; ++q) x(2, q) += 1e-4 * std::sin(x(0, q) * 400.0);
+  std::vector<double> work(static_cast<std::size_t>(net.node_capacity()));
+  LatticeForces forces(net);
+  for (auto _ : state) benchmark::DoNotOptimize(lattice ? forces.gershgorin_bound(net, x) : gershgorin_frequency_bound(net, x, work));
+}
+
+/// CPU time of the calling thread [s] (the per-sample cost of the tear storm, on a shared machine).
+double thread_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// A tear storm: clay_tear (experiments/scenes/clay_tear.toml) on a 24 x 8 x 8 box mesh of the
+/// 60 x 20 x 20 mm bar, as tests/realtime/springs/test_tearing.cpp sets it up (12 cells per side,
+/// h = 5 mm, styluses grasping the nodes within 7.5 mm, pulled apart at 5 mm/s each, tensile
+/// limit 50 kPa), 1 ms samples until 50 samples past the rupture (the vertex splits come one per
+/// sample, many in consecutive samples). Each sample's CPU time is taken alone; counters: the
+/// splits, the samples, the median, p99 and largest sample cost, the largest cost of a sample
+/// that split a vertex and of the sample after one (where the implicit and quasi-static
+/// integrators refactorise on the kept tear-ready pattern), and the samples over 1 ms.
+void tear_storm(benchmark::State& state, SpringIntegrator integrator) {
+  const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.06, 0.01, 0.02}, 24, 8, 8);
+  SpringNetworkSetup s;
+  s.youngs_modulus = 0.5e6;
+  s.poisson_ratio = 0.45;
+  s.density = 1700.0;
+  s.damping = 10.0;
+  s.integrator = integrator;
+  s.supports = {{"support", true}};
+  s.styluses = {{Eigen::Vector3d(0.015, 0.0, 0.022), 0.002}, {Eigen::Vector3d(0.045, 0.0, 0.022), 0.002}};
+  s.cells = 12;
+  s.grasp_radius = 0.0075;
+  s.tearing = true;
+  s.tensile_limit = 50e3;
+  SpringNetworkModel model(mesh, s);
+  std::vector<double> cost, tearing, after;
+  cost.reserve(2200);
+  for (auto _ : state) {
+    model.reset();
+    cost.clear(), tearing.clear(), after.clear();
+    std::array<ToolState, 2> tools;
+    std::array<ForceSample, 2> forces;
+    int rupture = -1;
+    bool split_before = false;
+    for (int k = 0; k <= 2000 && (rupture < 0 || k <= rupture + 50); ++k) {
+      const double d = 5e-6 * k;
+      tools[0].position = {0.015 - d, 0.0, 0.022};
+      tools[1].position = {0.045 + d, 0.0, 0.022};
+      const int tears = model.tears();
+      const double t0 = thread_seconds();
+      model.step(tools, 1e-3, forces);
+      const double c = thread_seconds() - t0;
+      cost.push_back(c);
+      if (split_before) after.push_back(c);
+      split_before = model.tears() > tears;
+      if (split_before) tearing.push_back(c);
+      if (rupture < 0 && forces[0].mode == InteractionMode::rupture) rupture = k;
+    }
+    state.counters["rupture_sample"] = rupture;
+  }
+  const auto largest = [](const std::vector<double>& v) { return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end()); };
+  std::vector<double> sorted = cost;
+  std::sort(sorted.begin(), sorted.end());
+  state.counters["splits"] = model.tears();
+  state.counters["samples"] = static_cast<double>(cost.size());
+  state.counters["median_us"] = 1e6 * sorted[sorted.size() / 2];
+  state.counters["p99_us"] = 1e6 * sorted[std::min(sorted.size() - 1, sorted.size() * 99 / 100)];
+  state.counters["max_us"] = 1e6 * sorted.back();
+  state.counters["max_splitting_sample_us"] = 1e6 * largest(tearing);
+  state.counters["max_sample_after_split_us"] = 1e6 * largest(after);
+  state.counters["samples_over_1ms"] = static_cast<double>(std::count_if(cost.begin(), cost.end(), [](double c) { return c > 1e-3; }));
 }
 
 void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
@@ -109,10 +238,20 @@ void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
 BENCHMARK_CAPTURE(step_cost, explicit, SpringIntegrator::symplectic_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit, SpringIntegrator::implicit_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, static, SpringIntegrator::quasi_static, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, explicit_10kHz, SpringIntegrator::symplectic_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, implicit_10kHz, SpringIntegrator::implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_peer, SpringIntegrator::symplectic_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit_peer, SpringIntegrator::implicit_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(system_cost, solve, false, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(system_cost, solve_double, false, NetworkSystem::SolvePrecision::double_precision)->Arg(8)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(system_cost, factorize, true, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(gershgorin_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(gershgorin_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(tear_storm, implicit, SpringIntegrator::implicit_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tear_storm, static, SpringIntegrator::quasi_static)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tear_storm, explicit, SpringIntegrator::symplectic_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, trilinear, EmbeddingScheme::trilinear)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, coons, EmbeddingScheme::coons)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);
 

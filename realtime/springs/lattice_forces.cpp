@@ -15,9 +15,6 @@ constexpr std::array<std::array<int, 3>, 13> directions{{{1, 0, 0},  {0, 1, 0}, 
                                                          {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}, {1, 1, 1},
                                                          {1, 1, -1}, {1, -1, 1}, {1, -1, -1}}};
 
-/// Local corner a's sign along axis i, s_a[i] ∈ {−1, +1} (corner a = bx + 2 by + 4 bz).
-constexpr double corner_sign(int a, int i) { return ((a >> i) & 1) ? 1.0 : -1.0; }
-
 /// The springs of one lattice direction, from lattice points p in [begin, end) to p + o: adds
 /// each spring's force on its start point to F and stores it in G (the end point takes −G).
 /// Returns their elastic energy [J].
@@ -106,22 +103,116 @@ double cell_volumes(int end, const int* corner, double c, double kappa_v0, doubl
 }
 
 /// F_r[q] −= Σ_a Σ_i s_a[i] Q_{i r}[pad + q − o_a] for lattice points q in [0, points): each
-/// point collects the volume forces of the (up to 8) cells it is a corner of.
+/// point collects the volume forces of the (up to 8) cells it is a corner of, in one pass per
+/// row r (24 reads, one update of F_r per point).
 KERF_VECTOR_CLONES
 void cell_volume_forces(int points, const int* corner, const double* __restrict Q, int stride, int pad,
                         double* __restrict FX, double* __restrict FY, double* __restrict FZ) {
   double* F[3] = {FX, FY, FZ};
+  const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
   for (int r = 0; r < 3; ++r) {
-    const double* __restrict Q0 = Q + r * stride + pad;
-    const double* __restrict Q1 = Q + (3 + r) * stride + pad;
-    const double* __restrict Q2 = Q + (6 + r) * stride + pad;
+    const double* __restrict A = Q + r * stride + pad;       // Q_0r: the s_a[0] column
+    const double* __restrict B = Q + (3 + r) * stride + pad; // Q_1r
+    const double* __restrict C = Q + (6 + r) * stride + pad; // Q_2r
     double* __restrict Fr = F[r];
-    for (int a = 0; a < 8; ++a) {
-      const int o = corner[a];
-      const double s0 = corner_sign(a, 0), s1 = corner_sign(a, 1), s2 = corner_sign(a, 2);
 #pragma omp simd
-      for (int q = 0; q < points; ++q) Fr[q] -= s0 * Q0[q - o] + s1 * Q1[q - o] + s2 * Q2[q - o];
+    for (int q = 0; q < points; ++q) {
+      // Σ_a (s_a[0] A + s_a[1] B + s_a[2] C)[q − o_a], corner a = bx + 2 by + 4 bz, s = 2b − 1
+      const double a = (A[q - o1] - A[q]) + (A[q - o3] - A[q - o2]) + (A[q - o5] - A[q - o4]) + (A[q - o7] - A[q - o6]);
+      const double b = (B[q - o2] - B[q]) + (B[q - o3] - B[q - o1]) + (B[q - o6] - B[q - o4]) + (B[q - o7] - B[q - o5]);
+      const double c = (C[q - o4] - C[q]) + (C[q - o5] - C[q - o1]) + (C[q - o6] - C[q - o2]) + (C[q - o7] - C[q - o3]);
+      Fr[q] -= a + b + c;
     }
+  }
+}
+
+/// Gershgorin row sums of one lattice direction's springs, p in [begin, end) to p + o:
+///   r = 2 k max(1, |1 − L/l|)  (l = 0: the crushed limit, 2 k 10⁶),
+/// added to R at the start point and stored in S for the end point.
+KERF_VECTOR_CLONES
+void direction_rows(int begin, int end, int o, double rest, const double* __restrict k, const double* __restrict X,
+                    const double* __restrict Y, const double* __restrict Z, double* __restrict R, double* __restrict S) {
+#pragma omp simd
+  for (int p = begin; p < end; ++p) {
+    const int q = p + o;
+    const double ex = X[q] - X[p], ey = Y[q] - Y[p], ez = Z[q] - Z[p];
+    const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double row = 2.0 * k[p] * std::max(1.0, l > 0.0 ? std::abs(1.0 - rest / l) : 1e6);
+    R[p] += row;
+    S[p] = row;
+  }
+}
+
+/// R[p + o] += S[p] for p in [begin, end): the end points' share of one direction's rows.
+KERF_VECTOR_CLONES
+void direction_row_ends(int begin, int end, int o, const double* __restrict S, double* __restrict R) {
+#pragma omp simd
+  for (int p = begin; p < end; ++p) R[p + o] += S[p];
+}
+
+/// Gershgorin row sums of the cells' volume term (cells starting at [0, end), mask 1 where a
+/// cell exists): with F = c Σ_a x_a ⊗ s_a (c = 1/(4h)), n_a = c |cof(F) s_a| = |∇_a J| and
+/// T = Σ_b n_b, corner a of the cell takes κ h³ n_a T, written to plane a of N (8 planes of
+/// `stride`, at pad + p).
+KERF_VECTOR_CLONES
+void cell_rows(int end, const int* corner, double c, double kappa_v0, const double* __restrict mask, const double* __restrict X,
+               const double* __restrict Y, const double* __restrict Z, double* __restrict N, int stride, int pad) {
+  const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
+  const auto column = [&](const double* __restrict W, int p, int i) {
+    switch (i) {
+    case 0: return c * ((W[p + o1] - W[p]) + (W[p + o3] - W[p + o2]) + (W[p + o5] - W[p + o4]) + (W[p + o7] - W[p + o6]));
+    case 1: return c * ((W[p + o2] - W[p]) + (W[p + o3] - W[p + o1]) + (W[p + o6] - W[p + o4]) + (W[p + o7] - W[p + o5]));
+    default: return c * ((W[p + o4] - W[p]) + (W[p + o5] - W[p + o1]) + (W[p + o6] - W[p + o2]) + (W[p + o7] - W[p + o3]));
+    }
+  };
+#pragma omp simd
+  for (int p = 0; p < end; ++p) {
+    const double ax = column(X, p, 0), ay = column(Y, p, 0), az = column(Z, p, 0);
+    const double bx = column(X, p, 1), by = column(Y, p, 1), bz = column(Z, p, 1);
+    const double dx = column(X, p, 2), dy = column(Y, p, 2), dz = column(Z, p, 2);
+    // cof(F) = [b × d, d × a, a × b]; cof(F) s_a = Σ_i s_a[i] cof_i
+    const double c0x = by * dz - bz * dy, c0y = bz * dx - bx * dz, c0z = bx * dy - by * dx;
+    const double c1x = dy * az - dz * ay, c1y = dz * ax - dx * az, c1z = dx * ay - dy * ax;
+    const double c2x = ay * bz - az * by, c2y = az * bx - ax * bz, c2z = ax * by - ay * bx;
+    double n[8];
+    double total = 0.0;
+    for (int a = 0; a < 8; ++a) {
+      const double s0 = (a & 1) ? 1.0 : -1.0, s1 = (a & 2) ? 1.0 : -1.0, s2 = (a & 4) ? 1.0 : -1.0;
+      const double gx = s0 * c0x + s1 * c1x + s2 * c2x, gy = s0 * c0y + s1 * c1y + s2 * c2y, gz = s0 * c0z + s1 * c1z + s2 * c2z;
+      n[a] = c * std::sqrt(gx * gx + gy * gy + gz * gz);
+      total += n[a];
+    }
+    for (int a = 0; a < 8; ++a) N[a * stride + pad + p] = mask[p] * kappa_v0 * n[a] * total;
+  }
+}
+
+/// R[q] += Σ_a N_a[pad + q − o_a] for lattice points q in [0, points).
+KERF_VECTOR_CLONES
+void cell_row_ends(int points, const int* corner, const double* __restrict N, int stride, int pad, double* __restrict R) {
+  const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
+  const double* __restrict N0 = N + pad;
+  const double* __restrict N1 = N + stride + pad;
+  const double* __restrict N2 = N + 2 * stride + pad;
+  const double* __restrict N3 = N + 3 * stride + pad;
+  const double* __restrict N4 = N + 4 * stride + pad;
+  const double* __restrict N5 = N + 5 * stride + pad;
+  const double* __restrict N6 = N + 6 * stride + pad;
+  const double* __restrict N7 = N + 7 * stride + pad;
+#pragma omp simd
+  for (int q = 0; q < points; ++q)
+    R[q] += ((N0[q] + N1[q - o1]) + (N2[q - o2] + N3[q - o3])) + ((N4[q - o4] + N5[q - o5]) + (N6[q - o6] + N7[q - o7]));
+}
+
+/// Symplectic Euler on the lattice planes, n entries: V += (h W) F, then X += (h U) V, with W
+/// the inverse mass on free axes (else 0) and U 1 on free axes (else 0).
+KERF_VECTOR_CLONES
+void lattice_update(int n, double h, const double* __restrict W, const double* __restrict U, const double* __restrict F,
+                    double* __restrict X, double* __restrict V) {
+#pragma omp simd
+  for (int e = 0; e < n; ++e) {
+    // v ← v + h f / m;  x ← x + h v
+    V[e] += h * W[e] * F[e];
+    X[e] += h * U[e] * V[e];
   }
 }
 
@@ -181,6 +272,21 @@ LatticeForces::LatticeForces(const SpringNetwork& net) {
   m_f.assign(3 * static_cast<std::size_t>(m_points), 0.0);
   m_g.assign(3 * static_cast<std::size_t>(m_points), 0.0);
   m_q.assign(9 * static_cast<std::size_t>(m_pad + m_points), 0.0);
+  m_inverse_mass.assign(3 * static_cast<std::size_t>(m_points), 0.0);
+  m_free.assign(3 * static_cast<std::size_t>(m_points), 0.0);
+  m_bound_weight.assign(static_cast<std::size_t>(m_points), 0.0);
+  m_row.assign(static_cast<std::size_t>(m_points), 0.0);
+  for (int p = 0; p < net.node_count; ++p) {
+    const auto s = static_cast<std::size_t>(m_slot[static_cast<std::size_t>(p)]);
+    const std::uint8_t fixed = net.constraint[static_cast<std::size_t>(p)];
+    const double inv_m = 1.0 / net.mass[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r)
+      if (!(fixed & (1u << r))) {
+        m_inverse_mass[static_cast<std::size_t>(r * m_points) + s] = inv_m;
+        m_free[static_cast<std::size_t>(r * m_points) + s] = 1.0;
+      }
+    if (fixed != fix_all) m_bound_weight[s] = inv_m;
+  }
   // Lattice points without a node keep their rest position (their springs have k = 0).
   for (int k = 0; k < pz; ++k)
     for (int j = 0; j < py; ++j)
@@ -195,21 +301,90 @@ bool LatticeForces::applies(const SpringNetwork& net) const noexcept {
   return m_node_count >= 0 && net.node_count == m_node_count && net.topology == m_topology;
 }
 
+void LatticeForces::gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
+  const int P = m_points;
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) {
+      m_x[static_cast<std::size_t>(r * P + s)] = x(r, p);
+      m_v[static_cast<std::size_t>(r * P + s)] = v(r, p);
+    }
+  }
+}
+
+void LatticeForces::place(int node, const Eigen::Vector3d& x, const Eigen::Vector3d& v) noexcept {
+  const int s = m_slot[static_cast<std::size_t>(node)];
+  for (int r = 0; r < 3; ++r) {
+    m_x[static_cast<std::size_t>(r * m_points + s)] = x[r];
+    m_v[static_cast<std::size_t>(r * m_points + s)] = v[r];
+  }
+}
+
+void LatticeForces::scatter(Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v) const noexcept {
+  const int P = m_points;
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) {
+      x(r, p) = m_x[static_cast<std::size_t>(r * P + s)];
+      v(r, p) = m_v[static_cast<std::size_t>(r * P + s)];
+    }
+  }
+}
+
+double LatticeForces::substep(const SpringNetwork& net, double h) noexcept {
+  const double energy = lattice_forces(net);
+  lattice_update(3 * m_points, h, m_inverse_mass.data(), m_free.data(), m_f.data(), m_x.data(), m_v.data());
+  return energy;
+}
+
 double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                                Eigen::Matrix3Xd& f) noexcept {
   if (!applies(net)) return network_forces(net, x, v, f);
+  gather(x, v);
+  const double energy = lattice_forces(net);
+  const int P = m_points;
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) f(r, p) = m_f[static_cast<std::size_t>(r * P + s)];
+  }
+  return energy;
+}
+
+double LatticeForces::gershgorin_bound(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept {
+  const int P = m_points;
+  double* X = m_x.data();
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) X[r * P + s] = x(r, p);
+  }
+  double* R = m_row.data();
+  std::fill(m_row.begin(), m_row.end(), 0.0);
+  for (std::size_t d = 0; d < directions.size(); ++d) {
+    const int o = m_offset[d];
+    const int begin = std::max(0, -o), end = P - std::max(0, o);
+    direction_rows(begin, end, o, net.rest_length(m_type[d]), m_k.data() + d * static_cast<std::size_t>(P), X, X + P, X + 2 * P, R,
+                   m_g.data());
+    direction_row_ends(begin, end, o, m_g.data(), R);
+  }
+  const double kappa = net.stiffness.volume_modulus;
+  if (kappa > 0.0) {
+    const double h = net.block.cell_size;
+    const int stride = m_pad + P;
+    cell_rows(P - m_pad, m_corner.data(), 1.0 / (4.0 * h), kappa * h * h * h, m_cell.data(), X, X + P, X + 2 * P, m_q.data(), stride,
+              m_pad);
+    cell_row_ends(P, m_corner.data(), m_q.data(), stride, m_pad, R);
+  }
+  double bound = 0.0;
+  for (int p = 0; p < P; ++p) bound = std::max(bound, R[p] * m_bound_weight[static_cast<std::size_t>(p)]);
+  return bound;
+}
+
+double LatticeForces::lattice_forces(const SpringNetwork& net) noexcept {
   const int P = m_points;
   double* X = m_x.data();
   double* V = m_v.data();
   double* F = m_f.data();
   double* G = m_g.data();
-  for (int p = 0; p < m_node_count; ++p) {
-    const int s = m_slot[static_cast<std::size_t>(p)];
-    for (int r = 0; r < 3; ++r) {
-      X[r * P + s] = x(r, p);
-      V[r * P + s] = v(r, p);
-    }
-  }
   std::fill(m_f.begin(), m_f.end(), 0.0);
   const double tau = net.damping_time;
   const double tiny = 1e-12 * net.block.cell_size;
@@ -228,10 +403,6 @@ double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd&
     energy += cell_volumes(P - m_pad, m_corner.data(), 1.0 / (4.0 * h), kappa * h * h * h, tau, m_cell.data(), X, X + P,
                            X + 2 * P, V, V + P, V + 2 * P, m_q.data(), stride, m_pad);
     cell_volume_forces(P, m_corner.data(), m_q.data(), stride, m_pad, F, F + P, F + 2 * P);
-  }
-  for (int p = 0; p < m_node_count; ++p) {
-    const int s = m_slot[static_cast<std::size_t>(p)];
-    for (int r = 0; r < 3; ++r) f(r, p) = F[r * P + s];
   }
   return energy;
 }

@@ -37,7 +37,30 @@ public:
   double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                   Eigen::Matrix3Xd& f) noexcept;
 
+  /// Symplectic Euler kept on the lattice between sub-steps (the arithmetic of
+  /// symplectic_euler_step, without gathering and scattering the state at every sub-step):
+  /// `gather` loads x and v (3 x capacity), `place` overwrites one node's position [m] and
+  /// velocity [m/s] (a prescribed node, e.g. under a stylus), `substep` advances by h [s]
+  ///   v ← v + h M⁻¹ f(x, v),  then  x ← x + h v   on the free axes (fixed axes keep what was
+  ///   placed; lumped masses, constraints as at construction),
+  /// and `scatter` writes x and v back. Only while `applies(net)`. Allocation-free.
+  void gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
+  void place(int node, const Eigen::Vector3d& x, const Eigen::Vector3d& v) noexcept;
+  /// One sub-step on the gathered state; returns the elastic energy at its start [J].
+  double substep(const SpringNetwork& net, double h) noexcept;
+  void scatter(Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v) const noexcept;
+
+  /// gershgorin_frequency_bound (symplectic_euler.hpp) at positions x [1/s²], on the lattice:
+  ///   max over nodes not fixed on all axes of (1/m_i) (Σ_{springs at i} 2 k max(1, |1 − L/l|)
+  ///   + Σ_{cells at i} κ h³ |∇_i J| Σ_b |∇_b J|).
+  /// Only while `applies(net)` (then equal to the flat-array bound to round-off); overwrites
+  /// the gathered positions. Allocation-free.
+  double gershgorin_bound(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept;
+
 private:
+  /// Forces of the gathered state into the lattice force planes; returns the elastic energy.
+  double lattice_forces(const SpringNetwork& net) noexcept;
+
   std::uint64_t m_topology = 0;
   int m_node_count = -1;
   int m_points = 0;                    ///< lattice points (Nx+1)(Ny+1)(Nz+1)
@@ -51,6 +74,10 @@ private:
   std::vector<double> m_x, m_v, m_f;   ///< 3 x points each (x, y, z planes)
   std::vector<double> m_g;             ///< 3 x points: one direction's spring forces
   std::vector<double> m_q;             ///< 9 x (pad + points): per cell P cof(F)/(4h), columns 0..2
+  std::vector<double> m_inverse_mass;  ///< 3 x points: 1/m on a node's free axes, else 0 [1/kg]
+  std::vector<double> m_free;          ///< 3 x points: 1 on a node's free axes, else 0
+  std::vector<double> m_bound_weight;  ///< points: 1/m of a node not fixed on all axes, else 0 [1/kg]
+  std::vector<double> m_row;           ///< points: Gershgorin row sums [N/m]
 };
 
 } // namespace kerf

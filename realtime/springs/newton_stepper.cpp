@@ -29,8 +29,12 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_f.setZero(3, cap);
   m_zero.setZero(3, cap);
   m_x_before.setZero(3, cap);
+  m_free_entry.assign(3 * static_cast<std::size_t>(cap), 0);
+  m_free_dof.assign(3 * static_cast<std::size_t>(cap), 0);
+  m_free_mass.assign(3 * static_cast<std::size_t>(cap), 0.0);
   m_r.setZero(m_system.dof_count());
   m_dx.setZero(m_system.dof_count());
+  bind_free_entries(net);
   m_factor_dt = -1.0;
   // Quasi-static regulariser: 1e-8 of the stiffness-to-mass scale k₁ / (cell mass / 8).
   m_static_regularisation = 1e-8 * net.stiffness.edge / (net.cell_mass / 8.0);
@@ -38,8 +42,24 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
 
 bool NewtonStepper::retopologise(const SpringNetwork& net) noexcept {
   if (!m_system.bind_split_vertices(net)) return false;
+  bind_free_entries(net);
   m_factor_dt = -1.0;
   return true;
+}
+
+void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
+  // Sized for every entry of the capacity (3 x capacity) at rebuild: binding after a split
+  // only rewrites them.
+  const auto& dof = m_system.dof_of();
+  m_free_count = 0;
+  for (int p = 0; p < net.node_count; ++p)
+    for (int i = 0; i < 3; ++i)
+      if (const int d = dof[static_cast<std::size_t>(3 * p + i)]; d >= 0) {
+        const auto k = static_cast<std::size_t>(m_free_count++);
+        m_free_entry[k] = 3 * p + i;
+        m_free_dof[k] = d;
+        m_free_mass[k] = net.mass[static_cast<std::size_t>(p)];
+      }
 }
 
 bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
@@ -53,24 +73,31 @@ bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x
 
 double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
                                double dt) noexcept {
-  const auto& dof = m_system.dof_of();
-  for (int p = 0; p < net.node_count; ++p)
-    for (int i = 0; i < 3; ++i)
-      if (dof[static_cast<std::size_t>(3 * p + i)] >= 0)
-        v(i, p) = m_mode == Mode::implicit_euler ? (x(i, p) - m_x0(i, p)) / dt : 0.0;
+  // Over the free entries only (entry e = 3 p + i of the 3 x capacity arrays, dof d, mass m).
+  const bool implicit = m_mode == Mode::implicit_euler;
+  const double* X = x.data();
+  const double* X0 = m_x0.data();
+  const double* V0 = m_v0.data();
+  double* V = v.data();
+  if (implicit)
+    for (int k = 0; k < m_free_count; ++k) {
+      const int e = m_free_entry[static_cast<std::size_t>(k)];
+      V[e] = (X[e] - X0[e]) / dt;
+    }
+  else
+    for (int k = 0; k < m_free_count; ++k) V[m_free_entry[static_cast<std::size_t>(k)]] = 0.0;
   // Quasi-static equilibrium has no damping: forces at zero velocity.
-  m_forces.evaluate(net, x, m_mode == Mode::implicit_euler ? v : m_zero, m_f);
+  m_forces.evaluate(net, x, implicit ? v : m_zero, m_f);
+  const double* F = m_f.data();
   double norm = 0.0;
-  for (int p = 0; p < net.node_count; ++p)
-    for (int i = 0; i < 3; ++i)
-      if (const int d = dof[static_cast<std::size_t>(3 * p + i)]; d >= 0) {
-        // implicit: r = M (x − xₙ − h vₙ)/h² − f;  quasi-static: r = −f
-        double r = -m_f(i, p);
-        if (m_mode == Mode::implicit_euler)
-          r += net.mass[static_cast<std::size_t>(p)] * (x(i, p) - m_x0(i, p) - dt * m_v0(i, p)) / (dt * dt);
-        m_r[d] = r;
-        norm = std::max(norm, std::abs(r));
-      }
+  for (int k = 0; k < m_free_count; ++k) {
+    const int e = m_free_entry[static_cast<std::size_t>(k)];
+    // implicit: r = M (x − xₙ − h vₙ)/h² − f;  quasi-static: r = −f
+    double r = -F[e];
+    if (implicit) r += m_free_mass[static_cast<std::size_t>(k)] * (X[e] - X0[e] - dt * V0[e]) / (dt * dt);
+    m_r[m_free_dof[static_cast<std::size_t>(k)]] = r;
+    norm = std::max(norm, std::abs(r));
+  }
   return norm;
 }
 
@@ -80,12 +107,12 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
   const int n = net.node_count;
   m_x0.leftCols(n) = x.leftCols(n);
   m_v0.leftCols(n) = v.leftCols(n);
-  const auto& dof = m_system.dof_of();
   // Warm start: the implicit step starts from the explicit predictor xₙ + h vₙ.
   if (m_mode == Mode::implicit_euler)
-    for (int p = 0; p < n; ++p)
-      for (int i = 0; i < 3; ++i)
-        if (dof[static_cast<std::size_t>(3 * p + i)] >= 0) x(i, p) += dt * v(i, p);
+    for (int k = 0; k < m_free_count; ++k) {
+      const int e = m_free_entry[static_cast<std::size_t>(k)];
+      x.data()[e] += dt * v.data()[e];
+    }
   // `fresh`: the kept factorisation was computed at the current iterate.
   bool fresh = false;
   if (m_mode == Mode::implicit_euler ? m_factor_dt != dt : m_factor_dt < 0.0) {
@@ -112,9 +139,10 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
     double trial = INFINITY;
     double alpha = 1.0;
     for (int halving = 0; halving <= 5; ++halving, alpha *= 0.5) {
-      for (int p = 0; p < n; ++p)
-        for (int i = 0; i < 3; ++i)
-          if (const int d = dof[static_cast<std::size_t>(3 * p + i)]; d >= 0) x(i, p) = m_x_before(i, p) - alpha * m_dx[d];
+      for (int k = 0; k < m_free_count; ++k) {
+        const int e = m_free_entry[static_cast<std::size_t>(k)];
+        x.data()[e] = m_x_before.data()[e] - alpha * m_dx[m_free_dof[static_cast<std::size_t>(k)]];
+      }
       trial = residual(net, x, v, dt);
       if (trial < norm) break;
     }

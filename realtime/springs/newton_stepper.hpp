@@ -8,6 +8,8 @@
 #include "realtime/springs/network_system.hpp"
 #include "realtime/springs/spring_network.hpp"
 
+#include <vector>
+
 namespace kerf {
 
 /// What one `advance` did.
@@ -58,6 +60,9 @@ public:
 private:
   bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
   double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+  /// The free entries (3 p + i with a dof) in node order, their dofs and node masses, from the
+  /// system's numbering (after rebuild and after binding splits). Allocation-free.
+  void bind_free_entries(const SpringNetwork& net) noexcept;
 
   Mode m_mode;
   int m_max_iterations;
@@ -69,6 +74,9 @@ private:
   double m_static_regularisation = 0.0;
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
   Eigen::VectorXd m_r, m_dx;
+  int m_free_count = 0;
+  std::vector<int> m_free_entry, m_free_dof; ///< per free entry: 3 p + i, and its dof
+  std::vector<double> m_free_mass;           ///< per free entry: the node's mass [kg]
 };
 
 } // namespace kerf

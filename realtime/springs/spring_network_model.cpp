@@ -259,6 +259,9 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   }
   for (int p = 0; p < net.node_count; ++p)
     if (m_attached_to[static_cast<std::size_t>(p)] >= 0) net.constraint[static_cast<std::size_t>(p)] = fix_all;
+  m_attached.clear();
+  for (int p = 0; p < net.node_count; ++p)
+    if (m_attached_to[static_cast<std::size_t>(p)] >= 0) m_attached.push_back(p);
   m_excluded.assign(static_cast<std::size_t>(net.node_capacity()), 0);
   for (int p = 0; p < net.node_count; ++p) m_excluded[static_cast<std::size_t>(p)] = m_attached_to[static_cast<std::size_t>(p)] >= 0;
 
@@ -308,9 +311,8 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
   }
   // Attached node target: rest + (tool position − stylus start), at fraction s of the sample.
   const auto place_attached = [&](double s) {
-    for (int p = 0; p < m_net.node_count; ++p) {
+    for (const int p : m_attached) {
       const int t = m_attached_to[static_cast<std::size_t>(p)];
-      if (t < 0) continue;
       const Eigen::Vector3d& from = m_last_tool[static_cast<std::size_t>(t)];
       const Eigen::Vector3d& to = tools[static_cast<std::size_t>(t)].position;
       const SpringStylus& tool = m_setup.styluses[static_cast<std::size_t>(t)];
@@ -332,16 +334,28 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
   if (m_setup.integrator == SpringIntegrator::symplectic_euler) {
     // The rest-state limit, shortened when the deformed tangent's Gershgorin bound has grown
     // (crushed springs, stretched cells): h_crit √(G_rest / G_now).
-    const double g_now = gershgorin_frequency_bound(m_net, m_x, m_gershgorin_work);
+    const bool on_lattice = m_lattice.applies(m_net);
+    const double g_now = on_lattice ? m_lattice.gershgorin_bound(m_net, m_x) : gershgorin_frequency_bound(m_net, m_x, m_gershgorin_work);
     const double limit = m_stability_limit * std::sqrt(std::min(1.0, m_gershgorin_rest / std::max(g_now, 1e-300)));
     const double ratio = dt / (explicit_safety * limit);
     int substeps = std::isfinite(ratio) ? static_cast<int>(std::ceil(ratio)) : 1;
     if (substeps > max_substeps) substeps = max_substeps, over_budget = true;
     substeps = std::max(substeps, 1);
     const double h = dt / substeps;
-    for (int k = 1; k <= substeps; ++k) {
-      place_attached(static_cast<double>(k) / substeps);
-      symplectic_euler_step(m_net, m_x, m_v, h, m_lattice, m_f);
+    if (on_lattice) {
+      // Untorn: the state stays in the lattice's arrays across the sub-steps.
+      m_lattice.gather(m_x, m_v);
+      for (int k = 1; k <= substeps; ++k) {
+        place_attached(static_cast<double>(k) / substeps);
+        for (const int p : m_attached) m_lattice.place(p, m_x.col(p), m_v.col(p));
+        m_lattice.substep(m_net, h);
+      }
+      m_lattice.scatter(m_x, m_v);
+    } else {
+      for (int k = 1; k <= substeps; ++k) {
+        place_attached(static_cast<double>(k) / substeps);
+        symplectic_euler_step(m_net, m_x, m_v, h, m_lattice, m_f);
+      }
     }
     m_last_substeps = substeps;
   } else {

@@ -126,6 +126,7 @@ private:
   CellIdentification m_identification;
   SpringNetwork m_initial, m_net;
   std::vector<int> m_attached_to;        ///< per node: stylus index or -1
+  std::vector<int> m_attached;           ///< the nodes attached to a stylus, in node order (never split)
   std::vector<double> m_gap;             ///< per node attached to a blade: its gap g [m]
   std::vector<std::uint8_t> m_excluded;  ///< per node: not torn (attached)
   Eigen::Matrix3Xd m_x, m_v, m_f;

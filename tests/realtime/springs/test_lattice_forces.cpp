@@ -3,6 +3,7 @@
 
 #include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/network_system.hpp"
+#include "realtime/springs/symplectic_euler.hpp"
 #include "tests/realtime/springs/network_fixtures.hpp"
 
 #include <Eigen/Dense>
@@ -96,6 +97,62 @@ TEST(LatticeForces, FallsBackToTheSpringLoopAfterASplit) {
   lattice.evaluate(s.net, s.x, s.v, f);
   const double scale = expected.leftCols(s.net.node_count).cwiseAbs().maxCoeff();
   EXPECT_LT((f - expected).leftCols(s.net.node_count).cwiseAbs().maxCoeff(), 1e-12 * scale);
+}
+
+/// The scattered block with its lowest layer of nodes fixed and one node fixed along x only.
+Scattered constrained_block(unsigned seed) {
+  Scattered s = scattered_block(seed);
+  const double bottom = s.net.rest.row(2).leftCols(s.net.node_count).minCoeff();
+  for (int n = 0; n < s.net.node_count; ++n)
+    if (s.net.rest(2, n) < bottom + 1e-9) s.net.constraint[static_cast<std::size_t>(n)] = fix_all;
+  s.net.constraint[static_cast<std::size_t>(s.net.node_count - 1)] = fix_x;
+  return s;
+}
+
+TEST(LatticeForces, GershgorinBoundEqualsTheFlatArrays) {
+  // The lattice's row sums against gershgorin_frequency_bound over the merged flat spring arrays
+  // and the cells one by one (the same bound summed in another order).
+  for (const unsigned seed : {1u, 2u}) {
+    Scattered s = constrained_block(seed);
+    LatticeForces lattice(s.net);
+    std::vector<double> work(static_cast<std::size_t>(s.net.node_capacity()));
+    const double expected = gershgorin_frequency_bound(s.net, s.x, work);
+    EXPECT_NEAR(lattice.gershgorin_bound(s.net, s.x), expected, 1e-12 * expected) << "seed " << seed;
+    // A crushed spring (the top edge of the last cell, its nodes 1e-3 h apart) raises the bound
+    // the same way on both.
+    const auto& top = s.net.cell_nodes.back();
+    ASSERT_NE(s.net.constraint[static_cast<std::size_t>(top[7])], fix_all);
+    s.x.col(top[7]) = s.x.col(top[6]) + Eigen::Vector3d(2.5e-6, 0, 0);
+    const double crushed = gershgorin_frequency_bound(s.net, s.x, work);
+    EXPECT_GT(crushed, 10.0 * expected);
+    EXPECT_NEAR(lattice.gershgorin_bound(s.net, s.x), crushed, 1e-12 * crushed) << "seed " << seed;
+  }
+}
+
+TEST(LatticeForces, SubstepsEqualSymplecticEulerSteps) {
+  // Sub-steps kept on the lattice (gather, place a prescribed node, substep, scatter) against
+  // symplectic_euler_step over network_forces, from a displaced, moving, damped state: the same
+  // trajectory to round-off.
+  Scattered s = constrained_block(3);
+  const double h = 0.5 * symplectic_euler_stability_limit(highest_angular_frequency(s.net), s.net.damping_time);
+  LatticeForces lattice(s.net);
+  Eigen::Matrix3Xd x = s.x, v = s.v, f(3, s.net.node_capacity());
+  const int fixed = 0; // a node of the fixed layer, moved by the caller every step
+  ASSERT_EQ(s.net.constraint[fixed], fix_all);
+  lattice.gather(s.x, s.v);
+  for (int k = 1; k <= 200; ++k) {
+    const Eigen::Vector3d target = s.net.rest.col(fixed) + Eigen::Vector3d(0, 0, 1e-5 * k), rate(0, 0, 1e-5 / h);
+    x.col(fixed) = target, v.col(fixed) = rate;
+    symplectic_euler_step(s.net, x, v, h, f);
+    lattice.place(fixed, target, rate);
+    lattice.substep(s.net, h);
+  }
+  Eigen::Matrix3Xd y(3, s.net.node_capacity()), w(3, s.net.node_capacity());
+  lattice.scatter(y, w);
+  const int n = s.net.node_count;
+  EXPECT_LT((y - x).leftCols(n).cwiseAbs().maxCoeff(), 1e-12 * (x - s.net.rest).leftCols(n).cwiseAbs().maxCoeff());
+  EXPECT_LT((w - v).leftCols(n).cwiseAbs().maxCoeff(), 1e-10 * v.leftCols(n).cwiseAbs().maxCoeff());
+  EXPECT_GT((x - s.x).leftCols(n).cwiseAbs().maxCoeff(), 1e-6); // it did move
 }
 
 TEST(NetworkSystem, SolvesAgainstADenseFactorisation) {
