@@ -265,6 +265,7 @@ struct FiniteStrainSolver::Impl {
     int edge_points = 0;        // blade edge points inside the body
     double edge_length = 0.0;   // their share of the edge [m]
     double max_line_load = 0.0; // [N/m]
+    double contact_energy = 0.0; // penalty energy stored in the tool contact (flanks and edge) [J]
   };
 
   double dirichlet_target(const DirichletDof& d, double load) const {
@@ -576,6 +577,7 @@ void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::Vec
   out.contact_points = 0;
   out.contact_area = 0.0;
   out.max_pressure = 0.0;
+  out.contact_energy = 0.0;
   if (with_matrix) {
     la.K = 0.0;
     *rhs = 0.0;
@@ -601,10 +603,10 @@ void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::Vec
   if (max(failure.empty() ? 0.0 : 1.0) > 0.0)
     throw FiniteStrainError(failure.empty() ? "finite strain: an element of another process failed" : failure);
   // The contact and traction tallies of every process's cells.
-  std::array<double, 10> tally{out.contact_on_body.x(), out.contact_on_body.y(), out.contact_on_body.z(),
+  std::array<double, 11> tally{out.contact_on_body.x(), out.contact_on_body.y(), out.contact_on_body.z(),
                                out.traction_on_body.x(), out.traction_on_body.y(), out.traction_on_body.z(),
                                static_cast<double>(out.contact_points), out.contact_area,
-                               static_cast<double>(out.edge_points), out.edge_length};
+                               static_cast<double>(out.edge_points), out.edge_length, out.contact_energy};
   sum(tally);
   out.contact_on_body = Eigen::Vector3d(tally[0], tally[1], tally[2]);
   out.traction_on_body = Eigen::Vector3d(tally[3], tally[4], tally[5]);
@@ -612,6 +614,7 @@ void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::Vec
   out.contact_area = tally[7];
   out.edge_points = static_cast<int>(tally[8]);
   out.edge_length = tally[9];
+  out.contact_energy = tally[10];
   out.max_pressure = max(out.max_pressure);
   out.max_line_load = max(out.max_line_load);
   out.residual = f_int;
@@ -708,6 +711,8 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
             ++out.contact_points;
             out.contact_area += JxW;
             out.max_pressure = std::max(out.max_pressure, penalty * c.penetration);
+            // Penalty energy ½ ε_N p² per reference area (its derivative is the traction above).
+            out.contact_energy += 0.5 * penalty * c.penetration * c.penetration * JxW;
             // ∂t_c/∂x = ε_N (−n⊗n + p ∂n/∂x)
             dt_dx = penalty * (-c.normal * c.normal.transpose() + c.penetration * c.normal_derivative);
           }
@@ -860,6 +865,8 @@ void FiniteStrainSolver::Impl::assemble_blade_edge(const VectorType& state, cons
     ++out.edge_points;
     out.edge_length += t.weight;
     out.max_line_load = std::max(out.max_line_load, t.line_load);
+    // W = ½ ε_L w d² = ½ w q² / ε_L with the line load q = ε_L d (blade_edge_contact.hpp).
+    out.contact_energy += 0.5 * t.weight * t.line_load * t.line_load / b.settings.line_penalty;
   }
 }
 
@@ -1153,6 +1160,7 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
   report.contact_points = assembly.contact_points;
   report.contact_area = assembly.contact_area;
   report.max_contact_pressure = assembly.max_pressure;
+  report.contact_energy = assembly.contact_energy;
   return report;
 }
 

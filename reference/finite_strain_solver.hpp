@@ -175,6 +175,9 @@ struct EquilibriumReport {
   int edge_contact_points = 0;       ///< blade edge points inside the body (blade_edge_contact.hpp)
   double edge_contact_length = 0.0;  ///< edge length in contact [m]
   double max_edge_line_load = 0.0;   ///< largest edge line load ε_L d [N/m]
+  /// Energy stored in the tool's penalty contact [J]: ∫ ½ ε_N p² dA over the flank points plus
+  /// Σ ½ ε_L w d² over the edge points (the potentials whose derivatives are the contact forces).
+  double contact_energy = 0.0;
   double assembly_seconds = 0.0;
   double linear_solve_seconds = 0.0;
   int linear_iterations = 0; ///< iterative solver: total CG iterations

@@ -362,7 +362,8 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
       crack_extent = solver.crack_extent(crack_direction);
     }
     previous_interface = interface;
-    energy.add_sample(tool_positions, forces_on_body, solver.strain_energy(), step.equilibrium.cohesive);
+    energy.add_sample(tool_positions, forces_on_body, solver.strain_energy(), step.equilibrium.cohesive,
+                      step.equilibrium.contact_energy);
     for (std::size_t j = 0; j < rp.tools.size(); ++j) {
       ProfileRow row;
       row.t = rp.times[k];
