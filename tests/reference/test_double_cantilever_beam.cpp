@@ -75,10 +75,7 @@ struct DoubleCantileverBeam {
 /// at the boundary.
 std::vector<double> graded_coordinates(double length, double fine_begin, double fine_end, double fine, double coarse,
                                        double growth = 1.5) {
-  std::vector<double> right; // from fine_end to length
-  std::vector<double> fine_part;
-  const int n_fine = static_cast<int>(std::lround((fine_end - fine_begin) / fine));
-  for (int i = 0; i <= n_fine; ++i) fine_part.push_back(fine_begin + (fine_end - fine_begin) * i / n_fine);
+  // The steps of one side, from the fine part outwards, scaled to fill `extent` exactly.
   auto side = [&](double extent) {
     std::vector<double> steps;
     double h = fine, covered = 0.0;
@@ -87,21 +84,16 @@ std::vector<double> graded_coordinates(double length, double fine_begin, double 
       steps.push_back(h);
       covered += h;
     }
-    // Rescale so that the steps fill the extent exactly.
-    if (!steps.empty())
-      for (double& s : steps) s *= extent / covered;
+    for (double& s : steps) s *= extent / covered;
     return steps;
   };
-  std::vector<double> x;
-  const std::vector<double> left_steps = side(fine_begin);
-  double pos = 0.0;
-  x.push_back(0.0);
-  for (auto it = left_steps.rbegin(); it != left_steps.rend(); ++it) x.push_back(pos += *it);
-  x.pop_back(); // == fine_begin, added by the fine part
-  if (left_steps.empty()) x.clear();
-  x.insert(x.end(), fine_part.begin(), fine_part.end());
-  pos = fine_end;
-  for (double s : side(length - fine_end)) x.push_back(pos += s);
+  std::vector<double> x{0.0};
+  const std::vector<double> left = side(fine_begin);
+  for (auto it = left.rbegin(); it + 1 < left.rend(); ++it) x.push_back(x.back() + *it); // up to fine_begin (excluded)
+  if (left.empty()) x.clear();
+  const int n_fine = static_cast<int>(std::lround((fine_end - fine_begin) / fine));
+  for (int i = 0; i <= n_fine; ++i) x.push_back(fine_begin + (fine_end - fine_begin) * i / n_fine);
+  for (double s : side(length - fine_end)) x.push_back(x.back() + s);
   x.back() = length;
   return x;
 }
@@ -119,13 +111,13 @@ struct DcbResult {
   int newton = 0, cutbacks = 0;
   double seconds = 0.0;
   double work = 0.0, strain = 0.0, interface = 0.0, cohesive = 0.0;
-  double peak = 0.0, peak_opening = 0.0;
+  double peak = 0.0; ///< largest load [N]
   double failed_area = 0.0, damaged_area = 0.0; ///< at the end [m²]
 };
 
 DcbResult run_dcb(const DoubleCantileverBeam& d, const DcbMesh& m, double max_opening, int steps) {
-  // Graded grid: fine from 2 mm before the initial tip to 18 mm past it (the crack grows by
-  // a₀ + χh times (sqrt(max δ/δ_c) − 1) ≈ 13.7 mm at δ = 2 δ_c, plus the zone ahead of it).
+  // Graded grid: fine from two elements behind the initial tip to 4 mm (the zone) beyond the LEFM tip
+  // at the last opening: the crack grows by (a₀ + χh)(sqrt(max δ/δ_c) − 1), 8.7 mm at δ = 1.6 δ_c.
   const double growth = (d.crack + DoubleCantileverBeam::chi() * d.arm) * (std::sqrt(max_opening / d.initiation_opening()) - 1.0);
   // The initial tip a₀ is a grid line (two fine elements behind it): the pre-crack and the ligament meet there.
   const double ahead = std::ceil((growth + 4e-3) / m.fine) * m.fine;
@@ -200,7 +192,6 @@ DcbResult run_dcb(const DoubleCantileverBeam& d, const DcbMesh& m, double max_op
     const CohesiveSummary& c = step.equilibrium.cohesive;
     if (upper > r.peak) {
       r.peak = upper;
-      r.peak_opening = opening;
     }
     r.interface = c.stored_energy;
     r.cohesive = c.dissipated_energy;
@@ -275,8 +266,15 @@ TEST(DoubleCantileverBeam, DISABLED_ConvergenceTable) {
   const DoubleCantileverBeam d;
   print_header(d);
   for (const DcbMesh m : {DcbMesh{2e-3, 2}, DcbMesh{1e-3, 2}, DcbMesh{0.5e-3, 2}, DcbMesh{0.5e-3, 4}}) {
-    const DcbResult r = run_dcb(d, m, kMaxOpeningRatio * d.initiation_opening(), kSteps);
-    print_row(m, r, errors(d, r));
+    try {
+      const DcbResult r = run_dcb(d, m, kMaxOpeningRatio * d.initiation_opening(), kSteps);
+      print_row(m, r, errors(d, r));
+    } catch (const LoadPathError& e) {
+      // An under-resolved zone: the crack jumps by an element and displacement control cannot follow.
+      std::printf("| %.3g | %d | the path stops at sample %zu of %d (δ = %.2f δ_c): cut-backs exhausted |\n", m.fine * 1e3,
+                  m.cells_per_arm, e.sample(), kSteps, kMaxOpeningRatio * static_cast<double>(e.sample()) / kSteps);
+      std::fflush(stdout);
+    }
   }
 }
 
