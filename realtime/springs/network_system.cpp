@@ -145,11 +145,11 @@ NetworkSystem::NetworkSystem(SolvePrecision precision) : m_precision(precision) 
   cholmod_start(m_common);
   m_common->supernodal = CHOLMOD_SUPERNODAL;
   m_common->print = 0;
-  // Try AMD and METIS's nested dissection and keep the ordering with the least fill (CHOLMOD's
-  // default tries METIS only when AMD's factor is very dense): on the 8³ block METIS's factor has
-  // 11 % fewer entries (3.93·10⁵ against 4.42·10⁵), which the triangular solves of every Newton
-  // iteration read; the analysis runs once per pattern.
-  m_common->nmethods = 3;
+  // CHOLMOD's default ordering choice (AMD; METIS only when AMD's factor is very dense). Trying
+  // METIS always (nmethods = 3) gave 11 % fewer entries in the 8³ factor and a ~10 % faster
+  // solve, but METIS's random number state is shared between threads: a study's parallel jobs
+  // then ordered differently from a serial run and its springs rows differed by 10⁻⁶
+  // (StudyRunner.ParallelRunsGiveTheSerialTablesApartFromCosts).
 }
 
 NetworkSystem::NetworkSystem(const SpringNetwork& net, SolvePrecision precision) : NetworkSystem(precision) { rebuild(net); }
@@ -474,9 +474,9 @@ template <class Value, class Real>
 }
 
 /// L y = b then Lᵀ x = y in place on x, on a supernodal L whose values are `lx`, in the
-/// arithmetic of `Real` (double on CHOLMOD's factor; single on its single-precision copy). Supernode s has columns [k1, k2) and a dense
-/// column-major block of nsrow rows (row indices ls[psi ..]): the first nscol rows are its
-/// diagonal triangle, the rest the rows below it. `inverse_diagonal` holds 1 / L_kk (no division
+/// arithmetic of `Real` (double on CHOLMOD's factor; single on its single-precision copy).
+/// Supernode s has columns [k1, k2) and a dense column-major block of nsrow rows (row indices
+/// ls[psi ..]): the first nscol rows are its diagonal triangle, the rest the rows below it. `inverse_diagonal` holds 1 / L_kk (no division
 /// on the solve's path); `below` has room for the tallest supernode, `dots` for the widest.
 ///
 /// Both off-diagonal products (L_bs x_s forward, L_bsᵀ x_b backward) take four columns per pass,

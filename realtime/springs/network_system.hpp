@@ -75,8 +75,11 @@ public:
   /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized):
   /// L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's supernodal L (dense
   /// column-major blocks): per supernode the diagonal triangle, then the rows below it as one
-  /// dense product, in loops the compiler vectorises, with no BLAS call per supernode (most
-  /// supernodes of a network are small, where the call overhead dominated cholmod_solve2).
+  /// dense product, four columns per pass, in loops the compiler vectorises, with no BLAS call
+  /// and no division (1/L_kk is kept) per supernode (most supernodes of a network are small,
+  /// where the call overhead dominated cholmod_solve2). In double precision, or (SolvePrecision
+  /// single_precision) in single precision on the factor's single-precision copy, rhs and out
+  /// converted once.
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept;
 
   /// The assembled matrix (lower triangle stored).
