@@ -15,6 +15,24 @@ constexpr std::array<std::array<int, 3>, 13> directions{{{1, 0, 0},  {0, 1, 0}, 
                                                          {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}, {1, 1, 1},
                                                          {1, 1, -1}, {1, -1, 1}, {1, -1, -1}}};
 
+/// The deformation gradient of one lattice cell, F = c Σ_a x_a ⊗ s_a (c = 1/(4h), s_a the corner
+/// signs), read column by column from coordinate planes: `o` are the lattice offsets of corners
+/// 1..7 from corner 0 (the cell's lower corner p).
+struct CellGradient {
+  int o1, o2, o3, o4, o5, o6, o7;
+  double c;
+  CellGradient(const int* corner, double c_)
+      : o1(corner[1]), o2(corner[2]), o3(corner[3]), o4(corner[4]), o5(corner[5]), o6(corner[6]), o7(corner[7]), c(c_) {}
+  /// Column i of c Σ_a w_a ⊗ s_a from one coordinate plane W (the row).
+  [[gnu::always_inline]] double column(const double* __restrict W, int p, int i) const {
+    switch (i) {
+    case 0: return c * ((W[p + o1] - W[p]) + (W[p + o3] - W[p + o2]) + (W[p + o5] - W[p + o4]) + (W[p + o7] - W[p + o6]));
+    case 1: return c * ((W[p + o2] - W[p]) + (W[p + o3] - W[p + o1]) + (W[p + o6] - W[p + o4]) + (W[p + o7] - W[p + o5]));
+    default: return c * ((W[p + o4] - W[p]) + (W[p + o5] - W[p + o1]) + (W[p + o6] - W[p + o2]) + (W[p + o7] - W[p + o3]));
+    }
+  }
+};
+
 /// The springs of one lattice direction, from lattice points p in [begin, end) to p + o: adds
 /// each spring's force on its start point to F and stores it in G (the end point takes −G).
 /// Returns their elastic energy [J].
@@ -67,30 +85,22 @@ double cell_volumes(int end, const int* corner, double c, double kappa_v0, doubl
                     const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
                     const double* __restrict VX, const double* __restrict VY, const double* __restrict VZ,
                     double* __restrict Q, int stride, int pad) {
-  const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
   double energy = 0.0;
-  // Column i of c Σ_a w_a ⊗ s_a from one coordinate plane W (the row), p the cell's lower corner.
-  const auto column = [&](const double* __restrict W, int p, int i) {
-    switch (i) {
-    case 0: return c * ((W[p + o1] - W[p]) + (W[p + o3] - W[p + o2]) + (W[p + o5] - W[p + o4]) + (W[p + o7] - W[p + o6]));
-    case 1: return c * ((W[p + o2] - W[p]) + (W[p + o3] - W[p + o1]) + (W[p + o6] - W[p + o4]) + (W[p + o7] - W[p + o5]));
-    default: return c * ((W[p + o4] - W[p]) + (W[p + o5] - W[p + o1]) + (W[p + o6] - W[p + o2]) + (W[p + o7] - W[p + o3]));
-    }
-  };
+  const CellGradient cell{corner, c};
 #pragma omp simd reduction(+ : energy)
   for (int p = 0; p < end; ++p) {
     // F columns a (i = 0), b (1), d (2); rows x, y, z.
-    const double ax = column(X, p, 0), ay = column(Y, p, 0), az = column(Z, p, 0);
-    const double bx = column(X, p, 1), by = column(Y, p, 1), bz = column(Z, p, 1);
-    const double dx = column(X, p, 2), dy = column(Y, p, 2), dz = column(Z, p, 2);
+    const double ax = cell.column(X, p, 0), ay = cell.column(Y, p, 0), az = cell.column(Z, p, 0);
+    const double bx = cell.column(X, p, 1), by = cell.column(Y, p, 1), bz = cell.column(Z, p, 1);
+    const double dx = cell.column(X, p, 2), dy = cell.column(Y, p, 2), dz = cell.column(Z, p, 2);
     // cof(F) = [b × d, d × a, a × b]
     const double c0x = by * dz - bz * dy, c0y = bz * dx - bx * dz, c0z = bx * dy - by * dx;
     const double c1x = dy * az - dz * ay, c1y = dz * ax - dx * az, c1z = dx * ay - dy * ax;
     const double c2x = ay * bz - az * by, c2y = az * bx - ax * bz, c2z = ax * by - ay * bx;
     const double J = ax * c0x + ay * c0y + az * c0z;
-    const double J_rate = c0x * column(VX, p, 0) + c0y * column(VY, p, 0) + c0z * column(VZ, p, 0) +
-                          c1x * column(VX, p, 1) + c1y * column(VY, p, 1) + c1z * column(VZ, p, 1) +
-                          c2x * column(VX, p, 2) + c2y * column(VY, p, 2) + c2z * column(VZ, p, 2);
+    const double J_rate = c0x * cell.column(VX, p, 0) + c0y * cell.column(VY, p, 0) + c0z * cell.column(VZ, p, 0) +
+                          c1x * cell.column(VX, p, 1) + c1y * cell.column(VY, p, 1) + c1z * cell.column(VZ, p, 1) +
+                          c2x * cell.column(VX, p, 2) + c2y * cell.column(VY, p, 2) + c2z * cell.column(VZ, p, 2);
     // P c = κ V₀ ((J − 1) + τ J̇) c, masked to the cells that exist
     const double pc = mask[p] * kappa_v0 * ((J - 1.0) + tau * J_rate) * c;
     const int at = pad + p;
@@ -157,19 +167,12 @@ void direction_row_ends(int begin, int end, int o, const double* __restrict S, d
 KERF_VECTOR_CLONES
 void cell_rows(int end, const int* corner, double c, double kappa_v0, const double* __restrict mask, const double* __restrict X,
                const double* __restrict Y, const double* __restrict Z, double* __restrict N, int stride, int pad) {
-  const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
-  const auto column = [&](const double* __restrict W, int p, int i) {
-    switch (i) {
-    case 0: return c * ((W[p + o1] - W[p]) + (W[p + o3] - W[p + o2]) + (W[p + o5] - W[p + o4]) + (W[p + o7] - W[p + o6]));
-    case 1: return c * ((W[p + o2] - W[p]) + (W[p + o3] - W[p + o1]) + (W[p + o6] - W[p + o4]) + (W[p + o7] - W[p + o5]));
-    default: return c * ((W[p + o4] - W[p]) + (W[p + o5] - W[p + o1]) + (W[p + o6] - W[p + o2]) + (W[p + o7] - W[p + o3]));
-    }
-  };
+  const CellGradient cell{corner, c};
 #pragma omp simd
   for (int p = 0; p < end; ++p) {
-    const double ax = column(X, p, 0), ay = column(Y, p, 0), az = column(Z, p, 0);
-    const double bx = column(X, p, 1), by = column(Y, p, 1), bz = column(Z, p, 1);
-    const double dx = column(X, p, 2), dy = column(Y, p, 2), dz = column(Z, p, 2);
+    const double ax = cell.column(X, p, 0), ay = cell.column(Y, p, 0), az = cell.column(Z, p, 0);
+    const double bx = cell.column(X, p, 1), by = cell.column(Y, p, 1), bz = cell.column(Z, p, 1);
+    const double dx = cell.column(X, p, 2), dy = cell.column(Y, p, 2), dz = cell.column(Z, p, 2);
     // cof(F) = [b × d, d × a, a × b]; cof(F) s_a = Σ_i s_a[i] cof_i
     const double c0x = by * dz - bz * dy, c0y = bz * dx - bx * dz, c0z = bx * dy - by * dx;
     const double c1x = dy * az - dz * ay, c1y = dz * ax - dx * az, c1z = dx * ay - dy * ax;
