@@ -1,6 +1,7 @@
 #include "viewer/shape_forming_adapter.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <vector>
 
