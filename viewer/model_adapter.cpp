@@ -2,6 +2,7 @@
 
 #include "viewer/edge_adapter.hpp"
 #include "viewer/fracture_adapter.hpp"
+#include "viewer/shape_forming_adapter.hpp"
 #include "viewer/springs_adapter.hpp"
 #include "viewer/voxel_adapter.hpp"
 
@@ -42,6 +43,7 @@ std::unique_ptr<ModelAdapter> make_model_adapter(const ToolModel& model, const T
   if (const auto* m = dynamic_cast<const VoxelSurfaceCuttingModel*>(&model)) return std::make_unique<VoxelAdapter>(*m, mesh);
   if (const auto* m = dynamic_cast<const FractureCuttingModel*>(&model)) return std::make_unique<FractureAdapter>(*m, mesh);
   if (const auto* m = dynamic_cast<const DiscreteEdgeCuttingModel*>(&model)) return std::make_unique<EdgeAdapter>(*m, mesh);
+  if (const auto* m = dynamic_cast<const ShapeFormingModel*>(&model)) return std::make_unique<ShapeFormingAdapter>(*m, mesh);
   return std::make_unique<RestBodyAdapter>(model, mesh);
 }
 

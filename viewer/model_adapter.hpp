@@ -33,7 +33,8 @@ public:
   [[nodiscard]] virtual std::string_view overlay_name() const = 0;
 };
 
-/// The adapter for `model` (springs, voxel, fracture, edge; recognised by its dynamic type),
+/// The adapter for `model` (springs, voxel, fracture, edge, and edge's shape forming on a blade
+/// and a stylus; recognised by its dynamic type),
 /// built on `mesh`, the scene mesh the model was built from. A model type without an adapter
 /// gets the rest mesh and no overlay (the tools, forces and text are drawn for every model).
 std::unique_ptr<ModelAdapter> make_model_adapter(const ToolModel& model, const TetMesh& mesh);

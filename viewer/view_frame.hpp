@@ -26,6 +26,10 @@ struct ModelState {
   int cell_count = 0;
   std::array<double, 24> scalars{};         ///< model-specific numbers (adapter-defined, SI units)
   std::uint64_t topology = 0;               ///< changes whenever `cells` changes (tears, cuts)
+  /// An object the model published and never changes afterwards (adapter-defined: the
+  /// shape-forming stage), or null. Read by the render thread; it lives until the model is reset
+  /// or destroyed, which happens only between sessions.
+  const void* published = nullptr;
 };
 
 /// Servo statistics as the servo thread last saw them (all zero outside a live session).

@@ -22,8 +22,10 @@ size=(--width 960 --height 640)
 # else the model re-stepped through the run's samples), and one live-view picture stepped off line.
 "$kerf" run clay_pull --model springs -o "$runs/clay_pull/springs"
 "$kerf" run clay_tear --model springs -o "$runs/clay_tear/springs"
+"$kerf" run clay_cut_apart --model edge -o "$runs/clay_cut_apart/edge"
 view "$runs/clay_pull/springs" --at 1.6 --no-chart "${size[@]}" --screenshot "$out/clay_pull_springs.png"
 view "$runs/clay_tear/springs" --at 3 --no-chart "${size[@]}" --screenshot "$out/clay_tear_springs.png"
+view "$runs/clay_cut_apart/edge" --at 3.8 --no-chart "${size[@]}" --screenshot "$out/clay_cut_apart_edge.png"
 view sponge_cut_constant --model voxel --at 1.2 "${size[@]}" --screenshot "$out/sponge_cut_voxel.png"
 view potato_rect_cut --model fracture --at 8 "${size[@]}" --screenshot "$out/potato_rect_cut_fracture.png"
 

@@ -108,6 +108,8 @@ void ShapeFormingModel::build_stage(const CuttableBody& body) {
   auto stage = std::make_unique<FormingStage>();
   stage->fragment = fragment;
   stage->mesh = fragment_mesh(body, fragment, stage->cut_mesh_node);
+  stage->cut_mesh = body.mesh();
+  stage->fragment_of_tet = body.fragment_of_tet();
   stage->springs = std::make_unique<SpringNetworkModel>(stage->mesh, m_setup.springs);
   stage->embedding = std::make_unique<NetworkEmbedding>(stage->springs->network(), stage->mesh.nodes, EmbeddingScheme::trilinear);
   m_stages.push_back(std::move(stage));

@@ -40,6 +40,11 @@ struct FormingStage {
   int fragment = -1;                      ///< fragment index in the cut body
   TetMesh mesh;                           ///< the fragment's tetrahedra and nodes
   std::vector<int> cut_mesh_node;         ///< node of the cut mesh for each node of `mesh`
+  /// The whole body as this cut left it (a copy of the CuttableBody's mesh and fragment labels
+  /// when the stage was built): what a reader outside the worker thread (the viewer) may read
+  /// once it holds the published stage, while the worker's own body may change with a later cut.
+  TetMesh cut_mesh;
+  std::vector<int> fragment_of_tet;       ///< fragment of each tetrahedron of `cut_mesh`
   std::unique_ptr<SpringNetworkModel> springs;
   std::unique_ptr<NetworkEmbedding> embedding;
 };
@@ -68,6 +73,7 @@ public:
 
   [[nodiscard]] DiscreteEdgeCuttingModel& edge() { return *m_edge; }
   [[nodiscard]] const DiscreteEdgeCuttingModel& edge() const { return *m_edge; }
+  [[nodiscard]] const ShapeFormingSetup& setup() const { return m_setup; }
   /// The stage the stylus is deforming (null before the first cut reached the servo thread).
   [[nodiscard]] const FormingStage* active_stage() const { return m_active; }
   /// Not realtime: the cut mesh with the active fragment's nodes moved by the network

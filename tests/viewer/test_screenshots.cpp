@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -18,6 +19,8 @@
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <utility>
+#include <vector>
 
 using kerf::test::PngImage;
 
@@ -203,6 +206,87 @@ TEST(ViewerScreenshot, TornClayShowsTwoFragmentsAlongTheTearLine) {
   const double gap_width = (runs[1].first - runs[0].second - 1) / f.pixels_per_metre;
   EXPECT_GT(gap_width, 0.015) << "the pieces should be 20 mm apart";
   EXPECT_LE(gap_width, 0.020 + 2.0 / f.pixels_per_metre) << "the pieces should be 20 mm apart";
+}
+
+// clay_cut_apart (experiments/scenes/clay_cut_apart.toml): a 30 x 10 x 10 mm clay bar resting on
+// a smooth plate (sliding support); a blade goes down through its full depth at x = 10 mm (1.2 s
+// at 10 mm/s) and clears below the base; from 1.8 s a stylus on the cube's top drags it 5 mm
+// along -x (1 s at 5 mm/s), then holds 1 s. Model `edge` (shape forming, paper 000 §4): the
+// geometric cut (§3.2) divides the mesh along its internal plane x = 10 mm into a 10 mm cube and
+// a 20 mm bar (the run's manifest: 2 fragments); the spring network built on the cube's fragment
+// (8 cells of 1.25 mm: the whole cube, nothing of it held but its base's height) carries it with
+// the stylus; the bar is in no network and keeps its nodes where the cut left them.
+// Where the separation comes from: the cut has no width (the blade's thickness is not removed,
+// the crack's node copies start where the nodes were), so after the cut and before the drag the
+// two pieces touch: one component. At the end the cube has moved with the stylus, 5 mm: the gap
+// is the stylus's travel, between the cube's cut face (10 - 5 mm) and the bar's (10 mm). Checked
+// in the band z in [1, 9] mm across the picture ("along the cut line", clear of the stylus above
+// the top and of the blade below the base): the 4-connected components of foreground pixels,
+// each with its column extent; the gap is measured between the two components' facing columns,
+// one pixel of silhouette rasterisation allowed at each side.
+TEST(ViewerScreenshot, CutClayShowsTwoFragmentsOnceThePieceIsDraggedAway) {
+  const auto run = scratch("clay_cut_apart_edge");
+  auto [code, out] = run_kerf("run clay_cut_apart --model edge -o " + run.string());
+  ASSERT_EQ(code, 0) << out;
+  {
+    // The model itself cut the bar through: its manifest counts two fragments (edge_builder.cpp,
+    // write_geometric_cut). Without that there would be nothing to separate.
+    std::ifstream manifest(run / "manifest.json");
+    const std::string text((std::istreambuf_iterator<char>(manifest)), std::istreambuf_iterator<char>());
+    ASSERT_NE(text.find("\"fragments\": 2"), std::string::npos) << "the edge model did not cut clay_cut_apart in two";
+  }
+  const auto rest = scratch("clay_cut_apart_0.png"), cut = scratch("clay_cut_apart_1.75.png"),
+             apart = scratch("clay_cut_apart_end.png");
+  const std::string common = "view " + run.string() + picture;
+  for (const auto& [file, at] : {std::pair{rest, "0"}, std::pair{cut, "1.75"}, std::pair{apart, "3.8"}}) {
+    auto [c, o] = run_kerf(common + " --screenshot " + file.string() + " --at " + at);
+    ASSERT_EQ(c, 0) << o;
+  }
+  const PngImage a = PngImage::read(rest), b = PngImage::read(cut), c = PngImage::read(apart);
+  const ImageFrame f = locate_block(a, 0.030);
+  ASSERT_GT(f.pixels_per_metre, 5000.0);
+  // 4-connected components of foreground in the band; their column extents, left to right.
+  auto components = [&](const PngImage& image) {
+    const int y0 = f.row(0.001), y1 = f.row(0.009);
+    const int rows = y1 - y0 + 1;
+    std::vector<int> label(static_cast<std::size_t>(rows) * image.width, -1);
+    std::vector<std::pair<int, int>> extents;
+    for (int y = y0; y <= y1; ++y)
+      for (int x = 0; x < image.width; ++x) {
+        if (!image.foreground(x, y) || label[static_cast<std::size_t>(y - y0) * image.width + x] >= 0) continue;
+        const int id = static_cast<int>(extents.size());
+        extents.emplace_back(x, x);
+        std::vector<std::pair<int, int>> stack{{x, y}};
+        label[static_cast<std::size_t>(y - y0) * image.width + x] = id;
+        while (!stack.empty()) {
+          const auto [px, py] = stack.back();
+          stack.pop_back();
+          extents[static_cast<std::size_t>(id)].first = std::min(extents[static_cast<std::size_t>(id)].first, px);
+          extents[static_cast<std::size_t>(id)].second = std::max(extents[static_cast<std::size_t>(id)].second, px);
+          for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}}) {
+            const int nx = px + dx, ny = py + dy;
+            if (nx < 0 || nx >= image.width || ny < y0 || ny > y1 || !image.foreground(nx, ny)) continue;
+            int& l = label[static_cast<std::size_t>(ny - y0) * image.width + nx];
+            if (l < 0) l = id, stack.emplace_back(nx, ny);
+          }
+        }
+      }
+    std::sort(extents.begin(), extents.end());
+    return extents;
+  };
+  EXPECT_EQ(components(a).size(), 1u) << "the uncut bar is one piece";
+  EXPECT_EQ(components(b).size(), 1u) << "cut but not yet dragged, the pieces touch (the cut has no width)";
+  const auto pieces = components(c);
+  ASSERT_EQ(pieces.size(), 2u) << "the cube dragged off the bar should be a fragment of its own";
+  const double tolerance = 1.0 / f.pixels_per_metre;
+  // The bar did not move: its cut face is the cut, x = 10 mm; its far end x = 30 mm.
+  EXPECT_NEAR(f.x(pieces[1].first), 0.010, tolerance);
+  EXPECT_NEAR(f.x(pieces[1].second), 0.030, tolerance);
+  // The cube moved with the stylus: x in [-5, 5] mm, 10 mm wide; the gap 5 mm.
+  EXPECT_NEAR(f.x(pieces[0].first), -0.005, tolerance);
+  EXPECT_NEAR(f.x(pieces[0].second), 0.005, tolerance);
+  const double gap = (pieces[1].first - pieces[0].second - 1) / f.pixels_per_metre;
+  EXPECT_NEAR(gap, 0.005, 2.0 * tolerance) << "the gap should be the stylus's 5 mm drag";
 }
 
 // kerf view RUN RUN: the same run side by side must give the same picture in both halves (one

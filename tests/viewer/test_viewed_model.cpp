@@ -198,15 +198,60 @@ TEST(SpringsAdapter, TornBodyMovesWithItsPieces) {
   EXPECT_GT(right, 100);
 }
 
+// The shape-forming model (clay_cut_apart.toml, model edge: a blade cuts a 10 mm cube off a
+// 30 x 10 x 10 mm bar at x = 10 mm, then the stylus drags the cube 5 mm along -x on the smooth
+// plate and holds it 1 s). Expected, from the scene alone: before the cut reaches the model, the
+// body at rest (the scene mesh); once cut, the body as the cut left it (more nodes: the crack's
+// copies) with no node moved yet; at the end the cube (rest x < 10 mm) translated by the
+// stylus's (-5, 0, 0) mm — free on the plate, held by nothing else, its network covering all of
+// it (8 cells of 1.25 mm), the 1 s hold damping its recoil — and the bar (rest x > 10 mm) in no
+// network, every node exactly where it was.
+TEST(ShapeFormingAdapter, DrawsTheCutBodyWithThePieceUnderTheStylusMoved) {
+  const Scene scene = read_scene(std::string(KERF_SCENES_DIR) + "/clay_cut_apart.toml");
+  const TetMesh mesh = scene_mesh(scene);
+  const BuiltModel built = make_model("edge", scene, mesh);
+  std::unique_ptr<ModelAdapter> adapter = make_model_adapter(built, mesh);
+  ViewedModel viewed(*built.model, *adapter, 1.0);
+  const std::array<double, 3> times{0.5, 1.75, 3.8};
+  std::vector<BodyGeometry> g;
+  step_through(viewed, sample_scene_trajectories(scene), times, [&](const ViewFrame& f) {
+    g.emplace_back();
+    adapter->geometry(f, g.back());
+  });
+  ASSERT_EQ(g.size(), 3u);
+  EXPECT_EQ(g[0].points, mesh.nodes) << "nothing is cut at 0.5 s (the blade is 4 mm deep)";
+  EXPECT_EQ(g[0].tets, mesh.tets);
+  ASSERT_GT(g[1].rest.rows(), mesh.nodes.rows()) << "the cut should have opened (node copies on the crack)";
+  // (Up to the rounding of the trilinear embedding of nodes at rest: 1e-9 m is a millionth of a
+  // cell.)
+  EXPECT_LT((g[1].points - g[1].rest).cwiseAbs().maxCoeff(), 1e-9) << "cut, not yet dragged: nothing moved";
+  ASSERT_EQ(g[2].rest.rows(), g[1].rest.rows());
+  int cube = 0, bar = 0;
+  for (Eigen::Index i = 0; i < g[2].rest.rows(); ++i) {
+    const Eigen::Vector3d u = (g[2].points.row(i) - g[2].rest.row(i)).transpose();
+    if (g[2].rest(i, 0) < 0.010 - 1e-9) {
+      ++cube;
+      EXPECT_NEAR((u - Eigen::Vector3d(-0.005, 0.0, 0.0)).norm(), 0.0, 1e-6) << "cube node " << i;
+    } else if (g[2].rest(i, 0) > 0.010 + 1e-9) {
+      ++bar;
+      EXPECT_EQ(u.norm(), 0.0) << "bar node " << i;
+    }
+  }
+  EXPECT_GT(cube, 100);
+  EXPECT_GT(bar, 100);
+}
+
 // What `kerf view SCENE --model M` and the replay of a run get from the catalogue: each model is
 // read by its own adapter (the overlay it draws names it), also where a builder wraps the model
 // proper for `kerf run`'s recording (BuiltModel::core_model()); a model without an adapter would
-// show its body at rest, which for these four would hide what they do.
+// show its body at rest, which for these would hide what they do (edge on a scene with a blade
+// and a stylus is the shape-forming model, paper 000 §4).
 TEST(ModelAdapter, EachCatalogueModelIsReadByItsOwnAdapter) {
   const std::vector<std::array<std::string, 3>> cases{{"clay_pull", "springs", "spring network"},
                                                       {"sponge_cut_constant", "voxel", "voxel grid"},
                                                       {"potato_rect_cut", "fracture", "crack"},
-                                                      {"potato_rect_cut", "edge", "discrete edge"}};
+                                                      {"potato_rect_cut", "edge", "discrete edge"},
+                                                      {"clay_cut_apart", "edge", "discrete edge, spring network"}};
   for (const auto& [scene_name, model, overlay] : cases) {
     const Scene scene = read_scene(std::string(KERF_SCENES_DIR) + "/" + scene_name + ".toml");
     const TetMesh mesh = scene_mesh(scene);

@@ -61,3 +61,8 @@ TEST(ViewedModelNoAllocation, SpringsOnClayPull) {
 TEST(ViewedModelNoAllocation, FractureOnPotato) { EXPECT_EQ(allocations_while_viewed("potato_rect_cut", "fracture", 1), 0); }
 TEST(ViewedModelNoAllocation, EdgeOnPotato) { EXPECT_EQ(allocations_while_viewed("potato_rect_cut", "edge", 1), 0); }
 TEST(ViewedModelNoAllocation, VoxelOnSponge) { EXPECT_EQ(allocations_while_viewed("sponge_cut_constant", "voxel", 1), 0); }
+// Shape forming (edge with a blade and a stylus): the edge's points, then the stage's network,
+// captured while the worker thread cuts (its allocations are its own thread's, not counted).
+TEST(ViewedModelNoAllocation, ShapeFormingOnClayCutApart) {
+  EXPECT_EQ(allocations_while_viewed("clay_cut_apart", "edge", 1), 0);
+}

@@ -65,6 +65,12 @@ TEST(ShapeForming, CutInTwoThenPullOnePiece) {
     area += 0.5 * (b - a).cross(c - a).norm();
   }
   EXPECT_NEAR(area, 0.016 * 0.040, 1e-12);
+  // The stage carries the body as this cut left it (what the viewer draws): the body's own mesh
+  // and fragment labels, the stage's fragment among them on exactly the stage's tetrahedra.
+  EXPECT_EQ(stage.cut_mesh.nodes, body.mesh().nodes);
+  EXPECT_EQ(stage.cut_mesh.tets, body.mesh().tets);
+  EXPECT_EQ(stage.fragment_of_tet, body.fragment_of_tet());
+  EXPECT_EQ(std::count(stage.fragment_of_tet.begin(), stage.fragment_of_tet.end(), stage.fragment), stage.mesh.tets.rows());
 
   // The pull: 5 mm up at 10 mm/s, then a hold.
   const Eigen::MatrixXd cut_nodes = body.mesh().nodes;
