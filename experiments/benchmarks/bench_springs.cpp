@@ -237,9 +237,11 @@ void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
 
 BENCHMARK_CAPTURE(step_cost, explicit, SpringIntegrator::symplectic_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit, SpringIntegrator::implicit_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, linear_implicit, SpringIntegrator::linearly_implicit_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, static, SpringIntegrator::quasi_static, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_10kHz, SpringIntegrator::symplectic_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit_10kHz, SpringIntegrator::implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, linear_implicit_10kHz, SpringIntegrator::linearly_implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_peer, SpringIntegrator::symplectic_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit_peer, SpringIntegrator::implicit_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);

@@ -1,8 +1,8 @@
 // The spring-network model (paper 000 §2) built from a scene: one or two sphere styluses, the
 // material's E, ν, ρ and damping, the scene's supports, tearing (at the material's cohesive
 // strength, or [models.springs] tensile_limit) only if the scene declares it; the network's
-// settings from [models.springs] (docs/scenes.md). Model option "integrator": explicit, implicit
-// or static (overrides the scene's).
+// settings from [models.springs] (docs/scenes.md). Model option "integrator": explicit, implicit,
+// static or linear-implicit (overrides the scene's).
 
 #include "experiments/run/model_builders.hpp"
 #include "meshes/atomic_file.hpp"
@@ -163,7 +163,7 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
       throw std::invalid_argument("model springs: unknown option \"" + key + "\" (known: integrator)");
     const auto integrator = spring_integrator_from_string(value);
     if (!integrator)
-      throw std::invalid_argument("model springs: integrator \"" + value + "\" is not one of explicit, implicit, static");
+      throw std::invalid_argument("model springs: integrator \"" + value + "\" is not one of explicit, implicit, static, linear-implicit");
     setup.integrator = *integrator;
   }
   const Material& m = scene.material;

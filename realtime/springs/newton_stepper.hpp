@@ -26,7 +26,17 @@ public:
     /// Backward Euler: M (x − xₙ − h vₙ)/h² = f(x, (x − xₙ)/h), v = (x − xₙ)/h.
     implicit_euler,
     /// Static equilibrium f(x, 0) = 0 per call (inertia and damping left out), v = 0.
-    quasi_static
+    quasi_static,
+    /// Linearly implicit (linearised backward) Euler, Baraff & Witkin, "Large steps in cloth
+    /// simulation", SIGGRAPH 1998, §4: backward Euler's equation linearised at the predictor
+    /// x* = xₙ + h vₙ and solved once, x = x* − A⁻¹ r(x*), v = (x − xₙ)/h, with A the kept
+    /// factorisation (refreshed when dt changes, after a tear, and at x* when the predictor's
+    /// residual max-norm exceeds both the tolerance and 4 x its smallest value since the last
+    /// factorisation: with a stale A a mode grows from sample to sample). One force evaluation
+    /// and one pair of triangular solves per call; the residual after the step is not evaluated, so
+    /// `forces()` keeps the forces at the predictor and the report is `converged` by definition
+    /// (its `residual` is the predictor's).
+    linearly_implicit_euler
   };
 
   /// Builds the system's pattern for `net` (allocates). `max_iterations` >= 1 per advance;
@@ -54,7 +64,7 @@ public:
 
   /// The internal forces at the state the last `advance` returned (at its velocities, or at
   /// zero velocity quasi-statically) [N], 3 x capacity: the residual's own evaluation, so the
-  /// caller need not recompute them.
+  /// caller need not recompute them. Linearly implicit: the forces at the predictor x*.
   [[nodiscard]] const Eigen::Matrix3Xd& forces() const { return m_f; }
 
 private:
@@ -72,6 +82,7 @@ private:
   bool m_tear_ready = false;
   double m_factor_dt = -1.0;
   double m_static_regularisation = 0.0;
+  double m_lowest_residual = 0.0; ///< linearly implicit: smallest predictor residual since the last factorisation [N]
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
   Eigen::VectorXd m_r, m_dx;
   int m_free_count = 0;

@@ -23,9 +23,12 @@ namespace kerf {
 enum class SpringIntegrator {
   symplectic_euler, ///< explicit, sub-stepped under the computed stability limit
   implicit_euler,   ///< backward Euler by Newton with a kept sparse LDLᵀ factorisation
-  quasi_static      ///< static equilibrium per sample (for comparison with the reference)
+  quasi_static,     ///< static equilibrium per sample (for comparison with the reference)
+  /// linearly implicit Euler (Baraff & Witkin 1998): backward Euler's Newton iteration taken
+  /// once per sample from the predictor, with the kept factorisation, no residual check
+  linearly_implicit_euler
 };
-/// "explicit", "implicit", "static".
+/// "explicit", "implicit", "static", "linear-implicit".
 std::string_view to_string(SpringIntegrator integrator);
 std::optional<SpringIntegrator> spring_integrator_from_string(std::string_view name);
 
@@ -127,6 +130,9 @@ private:
   SpringNetwork m_initial, m_net;
   std::vector<int> m_attached_to;        ///< per node: stylus index or -1
   std::vector<int> m_attached;           ///< the nodes attached to a stylus, in node order (never split)
+  /// The cells with an attached corner (attached nodes are never split, so the cells holding
+  /// them stay the same): the linearly implicit integrator sums their forces on the tools.
+  std::vector<int> m_tool_cells;
   std::vector<double> m_gap;             ///< per node attached to a blade: its gap g [m]
   std::vector<std::uint8_t> m_excluded;  ///< per node: not torn (attached)
   Eigen::Matrix3Xd m_x, m_v, m_f;
