@@ -40,7 +40,8 @@ constexpr BlockMaterial peer{50e3, 0.45, 1000.0, 1.0, 2e-3};
 /// A cube of side N cells whose whole volume is the network (cells = N), base bonded, a 2 mm
 /// stylus on the top centre moved up and down by 0.1 mm (period 0.2 s), samples of `dt` [s]
 /// (1 ms: a 1 kHz servo; 0.1 ms: 10 kHz).
-void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMaterial material, double dt = 1e-3) {
+void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMaterial material, double dt = 1e-3,
+               bool single_precision_forces = true) {
   const int n = static_cast<int>(state.range(0));
   const double side = material.cell_size * n;
   const TetMesh mesh = box_tet_mesh({0.0, 0.0, 0.0}, {side, side, side}, n, n, n);
@@ -51,6 +52,7 @@ void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMateri
   s.damping = material.damping;
   s.cells = n;
   s.integrator = integrator;
+  s.single_precision_forces = single_precision_forces;
   s.supports = {{"support", false}};
   s.styluses = {{Eigen::Vector3d(side / 2, side / 2, side + 2e-3), 2e-3}};
   SpringNetworkModel model(mesh, s);
@@ -236,10 +238,12 @@ void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
 } // namespace
 
 BENCHMARK_CAPTURE(step_cost, explicit, SpringIntegrator::symplectic_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, explicit_double, SpringIntegrator::symplectic_euler, clay, 1e-3, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit, SpringIntegrator::implicit_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, linear_implicit, SpringIntegrator::linearly_implicit_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, static, SpringIntegrator::quasi_static, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_10kHz, SpringIntegrator::symplectic_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, explicit_double_10kHz, SpringIntegrator::symplectic_euler, clay, 1e-4, false)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit_10kHz, SpringIntegrator::implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, linear_implicit_10kHz, SpringIntegrator::linearly_implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_peer, SpringIntegrator::symplectic_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);

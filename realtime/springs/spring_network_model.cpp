@@ -360,7 +360,8 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
       for (int k = 1; k <= substeps; ++k) {
         place_attached(static_cast<double>(k) / substeps);
         for (const int p : m_attached) m_lattice.place(p, m_x.col(p), m_v.col(p));
-        m_lattice.substep(m_net, h);
+        m_lattice.substep(m_net, h, m_setup.single_precision_forces ? LatticeForces::ForcePrecision::single_precision
+                                                                    : LatticeForces::ForcePrecision::double_precision);
       }
       m_lattice.scatter(m_x, m_v);
     } else {
