@@ -380,18 +380,16 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
   }
   for (int t = 0; t < n_tools; ++t) m_last_tool[static_cast<std::size_t>(t)] = tools[static_cast<std::size_t>(t)].position;
 
-  // The force on each stylus: the sum of the internal forces on its attached nodes (at the end
-  // of the sample; the Newton stepper's last residual evaluation already holds them; the
-  // linearly implicit step evaluates none at the end, so the cells holding attached nodes are
-  // summed alone).
-  const bool linearised = m_setup.integrator == SpringIntegrator::linearly_implicit_euler;
-  if (m_newton && !linearised)
-    m_f.leftCols(m_net.node_count) = m_newton->forces().leftCols(m_net.node_count);
-  else if (!m_newton)
-    m_lattice.evaluate(m_net, m_x, m_v, m_f);
+  // The force on each stylus: the sum of the internal forces on its attached nodes at the end
+  // of the sample. The Newton stepper's last residual evaluation already holds them; the
+  // explicit and the linearly implicit steps evaluate none at the end state, so there the
+  // forces of the cells holding attached nodes (every spring and volume term acting on such a
+  // node) are summed alone, instead of the whole network's.
+  const bool from_newton = m_newton && m_setup.integrator != SpringIntegrator::linearly_implicit_euler;
+  if (from_newton) m_f.leftCols(m_net.node_count) = m_newton->forces().leftCols(m_net.node_count);
   bool finite = m_x.leftCols(m_net.node_count).allFinite();
   for (int t = 0; t < n_tools; ++t) forces[static_cast<std::size_t>(t)] = ForceSample{Eigen::Vector3d::Zero(), InteractionMode::deformation_1, 0.0, over_budget};
-  if (linearised) {
+  if (!from_newton) {
     Eigen::Matrix<double, 3, 8> xc, vc, fc;
     for (const int cell : m_tool_cells) {
       const auto& nodes = m_net.cell_nodes[static_cast<std::size_t>(cell)];

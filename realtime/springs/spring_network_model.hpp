@@ -135,7 +135,8 @@ private:
   std::vector<int> m_attached_to;        ///< per node: stylus index or -1
   std::vector<int> m_attached;           ///< the nodes attached to a stylus, in node order (never split)
   /// The cells with an attached corner (attached nodes are never split, so the cells holding
-  /// them stay the same): the linearly implicit integrator sums their forces on the tools.
+  /// them stay the same): the explicit and linearly implicit integrators sum their forces on
+  /// the tools.
   std::vector<int> m_tool_cells;
   std::vector<double> m_gap;             ///< per node attached to a blade: its gap g [m]
   std::vector<std::uint8_t> m_excluded;  ///< per node: not torn (attached)
