@@ -22,6 +22,9 @@ struct NewtonReport {
 
 class NewtonStepper {
 public:
+  /// Linearly implicit Euler: the residual after the step is checked on every 8th call.
+  static constexpr int linearised_check_interval = 8;
+
   enum class Mode {
     /// Backward Euler: M (x − xₙ − h vₙ)/h² = f(x, (x − xₙ)/h), v = (x − xₙ)/h.
     implicit_euler,
@@ -30,12 +33,14 @@ public:
     /// Linearly implicit (linearised backward) Euler, Baraff & Witkin, "Large steps in cloth
     /// simulation", SIGGRAPH 1998, §4: backward Euler's equation linearised at the predictor
     /// x* = xₙ + h vₙ and solved once, x = x* − A⁻¹ r(x*), v = (x − xₙ)/h, with A the kept
-    /// factorisation (refreshed when dt changes, after a tear, and at x* when the predictor's
-    /// residual max-norm exceeds both the tolerance and 4 x its smallest value since the last
-    /// factorisation: with a stale A a mode grows from sample to sample). One force evaluation
-    /// and one pair of triangular solves per call; the residual after the step is not evaluated, so
-    /// `forces()` keeps the forces at the predictor and the report is `converged` by definition
-    /// (its `residual` is the predictor's).
+    /// factorisation (refreshed when dt changes, after a tear, and at the next call's x* when a
+    /// check finds it stale: every `linearised_check_interval`-th call also evaluates the
+    /// residual after the step, and a step that reduced it by less than 4 x (modified Newton's
+    /// criterion) marks it so; with a stale A a mode grows from sample to sample). One force
+    /// evaluation and one pair of triangular solves per call (a second evaluation on check
+    /// calls); otherwise the residual after the step is not evaluated, so `forces()` keeps the
+    /// forces at the predictor and the report is `converged` by definition (its `residual` is
+    /// the predictor's, or after the step on check calls).
     linearly_implicit_euler
   };
 
@@ -82,7 +87,8 @@ private:
   bool m_tear_ready = false;
   double m_factor_dt = -1.0;
   double m_static_regularisation = 0.0;
-  double m_lowest_residual = 0.0; ///< linearly implicit: smallest predictor residual since the last factorisation [N]
+  bool m_refresh_pending = false; ///< linearly implicit: the last check found the kept factorisation stale
+  int m_calls_since_check = 0;    ///< linearly implicit: calls since the residual after the step was last checked
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
   Eigen::VectorXd m_r, m_dx;
   int m_free_count = 0;
