@@ -513,14 +513,16 @@ double LatticeForces::lattice_forces_single(const SpringNetwork& net) noexcept {
 }
 
 double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
-                               Eigen::Matrix3Xd& f) noexcept {
+                               Eigen::Matrix3Xd& f, ForcePrecision precision) noexcept {
   if (!applies(net)) return network_forces(net, x, v, f);
   gather(x, v);
-  const double energy = lattice_forces(net);
+  const bool single = precision == ForcePrecision::single_precision;
+  const double energy = single ? lattice_forces_single(net) : lattice_forces(net);
   const int P = m_points;
   for (int p = 0; p < m_node_count; ++p) {
     const int s = m_slot[static_cast<std::size_t>(p)];
-    for (int r = 0; r < 3; ++r) f(r, p) = m_f[static_cast<std::size_t>(r * P + s)];
+    for (int r = 0; r < 3; ++r)
+      f(r, p) = single ? static_cast<double>(m_f_single[static_cast<std::size_t>(r * P + s)]) : m_f[static_cast<std::size_t>(r * P + s)];
   }
   return energy;
 }

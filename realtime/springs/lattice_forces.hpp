@@ -33,9 +33,12 @@ public:
   /// velocities v, exactly the sum network_forces computes (to round-off):
   ///   spring:  f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = (x_b − x_a)/l   (and −that on b);
   ///   volume:  f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a.
-  /// Returns the elastic energy Σ ½ k (l − L)² + Σ ½ κ V₀ (J − 1)² [J].
-  double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
-                  Eigen::Matrix3Xd& f) noexcept;
+  /// Returns the elastic energy Σ ½ k (l − L)² + Σ ½ κ V₀ (J − 1)² [J]. With
+  /// ForcePrecision::single_precision the loops run in single precision (see `substep`; after a
+  /// split the fallback is double).
+  enum class ForcePrecision { double_precision, single_precision };
+  double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& f,
+                  ForcePrecision precision = ForcePrecision::double_precision) noexcept;
 
   /// Symplectic Euler kept on the lattice between sub-steps (the arithmetic of
   /// symplectic_euler_step, without gathering and scattering the state at every sub-step):
@@ -51,7 +54,6 @@ public:
   /// by the previous sub-step's update) and of the velocities, with the spring stretch and
   /// J − 1 written without cancellation (l − L = (2 L·Δu + |Δu|²)/(l + L); J − 1 = tr G +
   /// I₂(G) + det G, F = I + G); twice the SIMD lanes. Positions and velocities stay double.
-  enum class ForcePrecision { double_precision, single_precision };
   /// One sub-step on the gathered state; returns the elastic energy at its start [J].
   double substep(const SpringNetwork& net, double h, ForcePrecision precision = ForcePrecision::double_precision) noexcept;
   void scatter(Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v) const noexcept;

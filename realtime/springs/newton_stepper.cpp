@@ -71,8 +71,8 @@ bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x
   return m_system.factorize();
 }
 
-double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
-                               double dt) noexcept {
+double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
+                               LatticeForces::ForcePrecision precision) noexcept {
   // Over the free entries only (entry e = 3 p + i of the 3 x capacity arrays, dof d, mass m).
   const bool implicit = m_mode != Mode::quasi_static;
   const double* X = x.data();
@@ -87,7 +87,7 @@ double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd&
   else
     for (int k = 0; k < m_free_count; ++k) V[m_free_entry[static_cast<std::size_t>(k)]] = 0.0;
   // Quasi-static equilibrium has no damping: forces at zero velocity.
-  m_forces.evaluate(net, x, implicit ? v : m_zero, m_f);
+  m_forces.evaluate(net, x, implicit ? v : m_zero, m_f, precision);
   const double* F = m_f.data();
   double norm = 0.0;
   for (int k = 0; k < m_free_count; ++k) {
@@ -125,7 +125,12 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
     fresh = true;
   }
   const double tolerance = m_tolerance_ratio * net.stiffness.edge * net.block.cell_size;
-  double norm = residual(net, x, v, dt);
+  // Backward Euler's predictor residual only sets the first Newton step (an approximate one
+  // already: the kept factor, read in single precision), so its forces are evaluated in single
+  // precision; every residual that decides convergence or a line-search step is double.
+  double norm = residual(net, x, v, dt,
+                         implicit ? LatticeForces::ForcePrecision::single_precision : LatticeForces::ForcePrecision::double_precision);
+  if (m_mode == Mode::implicit_euler && norm <= tolerance) norm = residual(net, x, v, dt); // converged already: decide in double
   if (m_mode == Mode::linearly_implicit_euler) {
     // A kept factorisation that no longer approximates the Jacobian lets a mode grow from
     // sample to sample (the step's error (I − A_kept⁻¹ A) e is amplified). Every

@@ -74,7 +74,8 @@ public:
 
 private:
   bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
-  double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+  double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
+                  LatticeForces::ForcePrecision precision = LatticeForces::ForcePrecision::double_precision) noexcept;
   /// The free entries (3 p + i with a dof) in node order, their dofs and node masses, from the
   /// system's numbering (after rebuild and after binding splits). Allocation-free.
   void bind_free_entries(const SpringNetwork& net) noexcept;
