@@ -116,6 +116,34 @@ float direction_springs_single(int begin, int end, int o, float ox, float oy, fl
   return energy;
 }
 
+/// direction_springs_single with the end points' share taken in the same loop (F[p + o] −= the
+/// force), for directions whose offset |o| is at least the widest SIMD width in single precision
+/// (16 lanes): then no two lanes of one vector touch the same point, and `safelen(16)` lets the
+/// loop vectorise although F is read and written at p and at p + o. Returns the elastic energy [J].
+KERF_VECTOR_CLONES
+float direction_springs_single_fused(int begin, int end, int o, float ox, float oy, float oz, float rest, float tau, float tiny,
+                                     const float* __restrict k, const float* __restrict UX, const float* __restrict UY,
+                                     const float* __restrict UZ, const float* __restrict VX, const float* __restrict VY,
+                                     const float* __restrict VZ, float* FX, float* FY, float* FZ) {
+  float energy = 0.0f;
+#pragma omp simd reduction(+ : energy) safelen(16)
+  for (int p = begin; p < end; ++p) {
+    const int q = p + o;
+    const float ux = UX[q] - UX[p], uy = UY[q] - UY[p], uz = UZ[q] - UZ[p];
+    const float ex = ox + ux, ey = oy + uy, ez = oz + uz;
+    const float l = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const float inv_l = l > tiny ? 1.0f / l : 0.0f;
+    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) / (l + rest);
+    const float rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
+    const float scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
+    const float gx = scale * ex, gy = scale * ey, gz = scale * ez;
+    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
+    FX[q] -= gx, FY[q] -= gy, FZ[q] -= gz;
+    energy += inv_l > 0.0f ? 0.5f * k[p] * stretch * stretch : 0.0f;
+  }
+  return energy;
+}
+
 /// cell_volumes in single precision on displacements U = x − X: F = I + G with G = c Σ_a u_a ⊗ s_a,
 /// and J − 1 = det(I + G) − 1 = tr G + I₂(G) + det G (I₂ the second invariant), without the
 /// cancellation of det F − 1 in single precision.
@@ -495,6 +523,13 @@ double LatticeForces::lattice_forces_single(const SpringNetwork& net) noexcept {
   for (std::size_t d = 0; d < directions.size(); ++d) {
     const int o = m_offset[d];
     const int begin = std::max(0, -o), end = P - std::max(0, o);
+    if (std::abs(o) >= 16) { // the end points' share in the same loop
+      energy += direction_springs_single_fused(
+          begin, end, o, static_cast<float>(h * directions[d][0]), static_cast<float>(h * directions[d][1]),
+          static_cast<float>(h * directions[d][2]), static_cast<float>(net.rest_length(m_type[d])), tau, tiny,
+          m_k_single.data() + d * static_cast<std::size_t>(P), U, U + P, U + 2 * P, V, V + P, V + 2 * P, F, F + P, F + 2 * P);
+      continue;
+    }
     energy += direction_springs_single(begin, end, o, static_cast<float>(h * directions[d][0]), static_cast<float>(h * directions[d][1]),
                                        static_cast<float>(h * directions[d][2]), static_cast<float>(net.rest_length(m_type[d])), tau,
                                        tiny, m_k_single.data() + d * static_cast<std::size_t>(P), U, U + P, U + 2 * P, V, V + P,
