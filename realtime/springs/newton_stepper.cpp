@@ -138,7 +138,17 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
     // the step reduced it by less than 4 x (modified Newton's criterion) the factorisation is
     // refreshed at the next call's predictor.
     if (m_refresh_pending && !fresh) {
-      if (refactor(net, x, dt)) ++report.factorisations;
+      if (!refactor(net, x, dt)) {
+        // A not positive definite at x*: no step this sample (the state stays at the predictor,
+        // reported unconverged), the refresh is tried again at the next.
+        for (int k = 0; k < m_free_count; ++k) {
+          const int e = m_free_entry[static_cast<std::size_t>(k)];
+          v.data()[e] = (x.data()[e] - m_x0.data()[e]) / dt;
+        }
+        report.residual = norm;
+        return report;
+      }
+      ++report.factorisations;
     }
     m_refresh_pending = false;
     // x = x* − A⁻¹ r(x*), v = (x − xₙ)/h: one linear solve.
