@@ -1,5 +1,7 @@
 // Cost of the spring network (paper 000 §2): one servo sample against N (N^3 cells) for each
-// integrator at 1 kHz (clay, and at 8^3 the peer setting) and at 10 kHz; the pieces of a
+// integrator at 1 kHz (clay, and at 8^3 the peer setting) and at 10 kHz — explicit (its
+// force loops in single precision; `explicit_double` in double), implicit (converged Newton),
+// linear_implicit (one solve per sample) and static; the pieces of a
 // sample (one force evaluation: the spring loop against the lattice loops; one pair of triangular
 // solves and one factorisation of the implicit system; the explicit integrator's Gershgorin
 // bound); a tear storm on clay_tear per integrator; and the embedding of 10^4 .. 10^6 fine nodes
@@ -256,6 +258,7 @@ BENCHMARK_CAPTURE(system_cost, factorize, true, NetworkSystem::SolvePrecision::s
 BENCHMARK_CAPTURE(gershgorin_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(gershgorin_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(tear_storm, implicit, SpringIntegrator::implicit_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tear_storm, linear_implicit, SpringIntegrator::linearly_implicit_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(tear_storm, static, SpringIntegrator::quasi_static)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(tear_storm, explicit, SpringIntegrator::symplectic_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, trilinear, EmbeddingScheme::trilinear)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);

@@ -20,7 +20,7 @@ namespace kerf {
 ///
 /// Returns the elimination rank (0 … count − 1) of every point, indexed x + nx (y + ny z).
 /// For the 8³ clay block of the benchmark (9 x 9 x 8 free points, 3 dofs each) the factor has
-/// ~2.9·10⁵ entries against AMD's 4.4·10⁵ (tests/realtime/springs/test_network_system.cpp).
+/// 2.94·10⁵ entries against AMD's 3.23·10⁵ (CHOLMOD's exact counts; tests/realtime/springs/test_lattice_dissection.cpp).
 [[nodiscard]] std::vector<int> lattice_nested_dissection(const Eigen::Vector3i& points, int leaf_points = 4);
 
 } // namespace kerf
