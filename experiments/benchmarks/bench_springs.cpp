@@ -1,5 +1,7 @@
 // Cost of the spring network (paper 000 §2): one servo sample against N (N^3 cells) for each
-// integrator at 1 kHz (clay, and at 8^3 the peer setting) and at 10 kHz; the pieces of a
+// integrator at 1 kHz (clay, and at 8^3 the peer setting) and at 10 kHz — explicit (its
+// force loops in single precision; `explicit_double` in double), implicit (converged Newton),
+// linear_implicit (one solve per sample) and static; the pieces of a
 // sample (one force evaluation: the spring loop against the lattice loops; one pair of triangular
 // solves and one factorisation of the implicit system; the explicit integrator's Gershgorin
 // bound); a tear storm on clay_tear per integrator; and the embedding of 10^4 .. 10^6 fine nodes
@@ -40,7 +42,8 @@ constexpr BlockMaterial peer{50e3, 0.45, 1000.0, 1.0, 2e-3};
 /// A cube of side N cells whose whole volume is the network (cells = N), base bonded, a 2 mm
 /// stylus on the top centre moved up and down by 0.1 mm (period 0.2 s), samples of `dt` [s]
 /// (1 ms: a 1 kHz servo; 0.1 ms: 10 kHz).
-void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMaterial material, double dt = 1e-3) {
+void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMaterial material, double dt = 1e-3,
+               bool single_precision_forces = true) {
   const int n = static_cast<int>(state.range(0));
   const double side = material.cell_size * n;
   const TetMesh mesh = box_tet_mesh({0.0, 0.0, 0.0}, {side, side, side}, n, n, n);
@@ -51,6 +54,7 @@ void step_cost(benchmark::State& state, SpringIntegrator integrator, BlockMateri
   s.damping = material.damping;
   s.cells = n;
   s.integrator = integrator;
+  s.single_precision_forces = single_precision_forces;
   s.supports = {{"support", false}};
   s.styluses = {{Eigen::Vector3d(side / 2, side / 2, side + 2e-3), 2e-3}};
   SpringNetworkModel model(mesh, s);
@@ -236,10 +240,14 @@ void embedding_cost(benchmark::State& state, EmbeddingScheme scheme) {
 } // namespace
 
 BENCHMARK_CAPTURE(step_cost, explicit, SpringIntegrator::symplectic_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, explicit_double, SpringIntegrator::symplectic_euler, clay, 1e-3, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit, SpringIntegrator::implicit_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, linear_implicit, SpringIntegrator::linearly_implicit_euler, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, static, SpringIntegrator::quasi_static, clay)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_10kHz, SpringIntegrator::symplectic_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, explicit_double_10kHz, SpringIntegrator::symplectic_euler, clay, 1e-4, false)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit_10kHz, SpringIntegrator::implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, linear_implicit_10kHz, SpringIntegrator::linearly_implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_peer, SpringIntegrator::symplectic_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit_peer, SpringIntegrator::implicit_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
@@ -250,6 +258,7 @@ BENCHMARK_CAPTURE(system_cost, factorize, true, NetworkSystem::SolvePrecision::s
 BENCHMARK_CAPTURE(gershgorin_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(gershgorin_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(tear_storm, implicit, SpringIntegrator::implicit_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(tear_storm, linear_implicit, SpringIntegrator::linearly_implicit_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(tear_storm, static, SpringIntegrator::quasi_static)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(tear_storm, explicit, SpringIntegrator::symplectic_euler)->Iterations(1)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(embedding_cost, trilinear, EmbeddingScheme::trilinear)->RangeMultiplier(10)->Range(10000, 1000000)->Unit(benchmark::kMillisecond);

@@ -1,8 +1,9 @@
 // The spring-network model (paper 000 §2) built from a scene: one or two sphere styluses, the
 // material's E, ν, ρ and damping, the scene's supports, tearing (at the material's cohesive
 // strength, or [models.springs] tensile_limit) only if the scene declares it; the network's
-// settings from [models.springs] (docs/scenes.md). Model option "integrator": explicit, implicit
-// or static (overrides the scene's).
+// settings from [models.springs] (docs/scenes.md). Model option "integrator": explicit (force
+// loops in single precision), explicit-double (in double precision), implicit, linear-implicit or
+// static (overrides the scene's).
 
 #include "experiments/run/model_builders.hpp"
 #include "meshes/atomic_file.hpp"
@@ -161,10 +162,15 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
   for (const auto& [key, value] : options) {
     if (key != "integrator")
       throw std::invalid_argument("model springs: unknown option \"" + key + "\" (known: integrator)");
-    const auto integrator = spring_integrator_from_string(value);
+    // "explicit-double": symplectic Euler with its force loops in double precision ("explicit":
+    // single precision, the default).
+    const bool double_forces = value == "explicit-double";
+    const auto integrator = double_forces ? SpringIntegrator::symplectic_euler : spring_integrator_from_string(value);
     if (!integrator)
-      throw std::invalid_argument("model springs: integrator \"" + value + "\" is not one of explicit, implicit, static");
+      throw std::invalid_argument("model springs: integrator \"" + value +
+                                  "\" is not one of explicit, explicit-double, implicit, linear-implicit, static");
     setup.integrator = *integrator;
+    setup.single_precision_forces = !double_forces;
   }
   const Material& m = scene.material;
   // A calibrated scene scales the modulus the spring constants are identified from ([models.springs]).
@@ -199,6 +205,8 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
   const CellIdentification& id = model->identification();
   nlohmann::json p;
   p["integrator"] = std::string(to_string(setup.integrator));
+  if (setup.integrator == SpringIntegrator::symplectic_euler)
+    p["force_precision"] = setup.single_precision_forces ? "single" : "double";
   p["cells_per_side"] = setup.cells;
   p["cell_size_m"] = net.block.cell_size;
   p["block_origin_m"] = nlohmann::json::array({net.block.origin.x(), net.block.origin.y(), net.block.origin.z()});

@@ -62,15 +62,134 @@ double direction_springs(int begin, int end, int o, double rest, double tau, dou
 }
 
 /// F[p + o] −= G[p] for p in [begin, end): the end points' share of one direction's springs.
-KERF_VECTOR_CLONES
-void direction_ends(int begin, int end, int o, const double* __restrict GX, const double* __restrict GY,
-                    const double* __restrict GZ, double* __restrict FX, double* __restrict FY, double* __restrict FZ) {
+template <class Real>
+[[gnu::always_inline]] inline void direction_ends_of(int begin, int end, int o, const Real* __restrict GX, const Real* __restrict GY,
+                                                     const Real* __restrict GZ, Real* __restrict FX, Real* __restrict FY,
+                                                     Real* __restrict FZ) {
 #pragma omp simd
   for (int p = begin; p < end; ++p) {
     FX[p + o] -= GX[p];
     FY[p + o] -= GY[p];
     FZ[p + o] -= GZ[p];
   }
+}
+KERF_VECTOR_CLONES
+void direction_ends(int begin, int end, int o, const double* __restrict GX, const double* __restrict GY,
+                    const double* __restrict GZ, double* __restrict FX, double* __restrict FY, double* __restrict FZ) {
+  direction_ends_of(begin, end, o, GX, GY, GZ, FX, FY, FZ);
+}
+KERF_VECTOR_CLONES
+void direction_ends_single(int begin, int end, int o, const float* __restrict GX, const float* __restrict GY,
+                           const float* __restrict GZ, float* __restrict FX, float* __restrict FY, float* __restrict FZ) {
+  direction_ends_of(begin, end, o, GX, GY, GZ, FX, FY, FZ);
+}
+
+/// direction_springs in single precision on displacements from the lattice's rest positions
+/// (U = x − X, so that the spring vector e = h o_d + (U[q] − U[p]) keeps the displacement's
+/// digits, where single-precision absolute positions would lose them), with the stretch written
+/// without cancellation, l − L = (2 L_vec·Δu + |Δu|²) / (l + L). Forces into F (single), the
+/// end points' share into G; returns the elastic energy [J].
+KERF_VECTOR_CLONES
+float direction_springs_single(int begin, int end, int o, float ox, float oy, float oz, float rest, float tau, float tiny,
+                               const float* __restrict k, const float* __restrict UX, const float* __restrict UY,
+                               const float* __restrict UZ, const float* __restrict VX, const float* __restrict VY,
+                               const float* __restrict VZ, float* __restrict FX, float* __restrict FY, float* __restrict FZ,
+                               float* __restrict GX, float* __restrict GY, float* __restrict GZ) {
+  float energy = 0.0f;
+#pragma omp simd reduction(+ : energy)
+  for (int p = begin; p < end; ++p) {
+    const int q = p + o;
+    const float ux = UX[q] - UX[p], uy = UY[q] - UY[p], uz = UZ[q] - UZ[p];
+    const float ex = ox + ux, ey = oy + uy, ez = oz + uz;
+    const float l = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const float inv_l = l > tiny ? 1.0f / l : 0.0f;
+    // l − L = (l² − L²)/(l + L),  l² − L² = 2 L_vec·Δu + |Δu|²
+    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) / (l + rest);
+    const float rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
+    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
+    const float scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
+    const float gx = scale * ex, gy = scale * ey, gz = scale * ez;
+    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
+    GX[p] = gx, GY[p] = gy, GZ[p] = gz;
+    energy += inv_l > 0.0f ? 0.5f * k[p] * stretch * stretch : 0.0f;
+  }
+  return energy;
+}
+
+/// direction_springs_single with the end points' share taken in the same loop (F[p + o] −= the
+/// force), for directions whose offset |o| is at least the widest SIMD width in single precision
+/// (16 lanes): then no two lanes of one vector touch the same point, and `safelen(16)` lets the
+/// loop vectorise although F is read and written at p and at p + o. Returns the elastic energy [J].
+KERF_VECTOR_CLONES
+float direction_springs_single_fused(int begin, int end, int o, float ox, float oy, float oz, float rest, float tau, float tiny,
+                                     const float* __restrict k, const float* __restrict UX, const float* __restrict UY,
+                                     const float* __restrict UZ, const float* __restrict VX, const float* __restrict VY,
+                                     const float* __restrict VZ, float* FX, float* FY, float* FZ) {
+  float energy = 0.0f;
+#pragma omp simd reduction(+ : energy) safelen(16)
+  for (int p = begin; p < end; ++p) {
+    const int q = p + o;
+    const float ux = UX[q] - UX[p], uy = UY[q] - UY[p], uz = UZ[q] - UZ[p];
+    const float ex = ox + ux, ey = oy + uy, ez = oz + uz;
+    const float l = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const float inv_l = l > tiny ? 1.0f / l : 0.0f;
+    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) / (l + rest);
+    const float rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
+    const float scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
+    const float gx = scale * ex, gy = scale * ey, gz = scale * ez;
+    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
+    FX[q] -= gx, FY[q] -= gy, FZ[q] -= gz;
+    energy += inv_l > 0.0f ? 0.5f * k[p] * stretch * stretch : 0.0f;
+  }
+  return energy;
+}
+
+/// cell_volumes in single precision on displacements U = x − X: F = I + G with G = c Σ_a u_a ⊗ s_a,
+/// and J − 1 = det(I + G) − 1 = tr G + I₂(G) + det G (I₂ the second invariant), without the
+/// cancellation of det F − 1 in single precision.
+KERF_VECTOR_CLONES
+float cell_volumes_single(int end, const int* corner, float c, float kappa_v0, float tau, const float* __restrict mask,
+                          const float* __restrict UX, const float* __restrict UY, const float* __restrict UZ,
+                          const float* __restrict VX, const float* __restrict VY, const float* __restrict VZ,
+                          float* __restrict Q, int stride, int pad) {
+  float energy = 0.0f;
+  const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
+  const auto column = [=](const float* __restrict W, int p, int i) -> float {
+    switch (i) {
+    case 0: return c * ((W[p + o1] - W[p]) + (W[p + o3] - W[p + o2]) + (W[p + o5] - W[p + o4]) + (W[p + o7] - W[p + o6]));
+    case 1: return c * ((W[p + o2] - W[p]) + (W[p + o3] - W[p + o1]) + (W[p + o6] - W[p + o4]) + (W[p + o7] - W[p + o5]));
+    default: return c * ((W[p + o4] - W[p]) + (W[p + o5] - W[p + o1]) + (W[p + o6] - W[p + o2]) + (W[p + o7] - W[p + o3]));
+    }
+  };
+#pragma omp simd reduction(+ : energy)
+  for (int p = 0; p < end; ++p) {
+    // G columns (i = 0, 1, 2), rows x, y, z: G_ri.
+    const float g00 = column(UX, p, 0), g10 = column(UY, p, 0), g20 = column(UZ, p, 0);
+    const float g01 = column(UX, p, 1), g11 = column(UY, p, 1), g21 = column(UZ, p, 1);
+    const float g02 = column(UX, p, 2), g12 = column(UY, p, 2), g22 = column(UZ, p, 2);
+    // F = I + G: columns a, b, d.
+    const float ax = 1.0f + g00, ay = g10, az = g20;
+    const float bx = g01, by = 1.0f + g11, bz = g21;
+    const float dx = g02, dy = g12, dz = 1.0f + g22;
+    const float c0x = by * dz - bz * dy, c0y = bz * dx - bx * dz, c0z = bx * dy - by * dx;
+    const float c1x = dy * az - dz * ay, c1y = dz * ax - dx * az, c1z = dx * ay - dy * ax;
+    const float c2x = ay * bz - az * by, c2y = az * bx - ax * bz, c2z = ax * by - ay * bx;
+    // J − 1 = tr G + I₂(G) + det G
+    const float trace = g00 + g11 + g22;
+    const float second = (g00 * g11 - g01 * g10) + (g11 * g22 - g12 * g21) + (g00 * g22 - g02 * g20);
+    const float det = g00 * (g11 * g22 - g12 * g21) - g01 * (g10 * g22 - g12 * g20) + g02 * (g10 * g21 - g11 * g20);
+    const float j_minus_1 = trace + (second + det);
+    const float J_rate = c0x * column(VX, p, 0) + c0y * column(VY, p, 0) + c0z * column(VZ, p, 0) +
+                         c1x * column(VX, p, 1) + c1y * column(VY, p, 1) + c1z * column(VZ, p, 1) +
+                         c2x * column(VX, p, 2) + c2y * column(VY, p, 2) + c2z * column(VZ, p, 2);
+    const float pc = mask[p] * kappa_v0 * (j_minus_1 + tau * J_rate) * c;
+    const int at = pad + p;
+    Q[at] = pc * c0x, Q[stride + at] = pc * c0y, Q[2 * stride + at] = pc * c0z;
+    Q[3 * stride + at] = pc * c1x, Q[4 * stride + at] = pc * c1y, Q[5 * stride + at] = pc * c1z;
+    Q[6 * stride + at] = pc * c2x, Q[7 * stride + at] = pc * c2y, Q[8 * stride + at] = pc * c2z;
+    energy += 0.5f * kappa_v0 * mask[p] * j_minus_1 * j_minus_1;
+  }
+  return energy;
 }
 
 /// The volume term of the cells starting at lattice points [0, end) (mask 1 where a cell
@@ -115,25 +234,35 @@ double cell_volumes(int end, const int* corner, double c, double kappa_v0, doubl
 /// F_r[q] −= Σ_a Σ_i s_a[i] Q_{i r}[pad + q − o_a] for lattice points q in [0, points): each
 /// point collects the volume forces of the (up to 8) cells it is a corner of, in one pass per
 /// row r (24 reads, one update of F_r per point).
-KERF_VECTOR_CLONES
-void cell_volume_forces(int points, const int* corner, const double* __restrict Q, int stride, int pad,
-                        double* __restrict FX, double* __restrict FY, double* __restrict FZ) {
-  double* F[3] = {FX, FY, FZ};
+template <class Real>
+[[gnu::always_inline]] inline void cell_volume_forces_of(int points, const int* corner, const Real* __restrict Q, int stride, int pad,
+                                                         Real* __restrict FX, Real* __restrict FY, Real* __restrict FZ) {
+  Real* F[3] = {FX, FY, FZ};
   const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
   for (int r = 0; r < 3; ++r) {
-    const double* __restrict A = Q + r * stride + pad;       // Q_0r: the s_a[0] column
-    const double* __restrict B = Q + (3 + r) * stride + pad; // Q_1r
-    const double* __restrict C = Q + (6 + r) * stride + pad; // Q_2r
-    double* __restrict Fr = F[r];
+    const Real* __restrict A = Q + r * stride + pad;       // Q_0r: the s_a[0] column
+    const Real* __restrict B = Q + (3 + r) * stride + pad; // Q_1r
+    const Real* __restrict C = Q + (6 + r) * stride + pad; // Q_2r
+    Real* __restrict Fr = F[r];
 #pragma omp simd
     for (int q = 0; q < points; ++q) {
       // Σ_a (s_a[0] A + s_a[1] B + s_a[2] C)[q − o_a], corner a = bx + 2 by + 4 bz, s = 2b − 1
-      const double a = (A[q - o1] - A[q]) + (A[q - o3] - A[q - o2]) + (A[q - o5] - A[q - o4]) + (A[q - o7] - A[q - o6]);
-      const double b = (B[q - o2] - B[q]) + (B[q - o3] - B[q - o1]) + (B[q - o6] - B[q - o4]) + (B[q - o7] - B[q - o5]);
-      const double c = (C[q - o4] - C[q]) + (C[q - o5] - C[q - o1]) + (C[q - o6] - C[q - o2]) + (C[q - o7] - C[q - o3]);
+      const Real a = (A[q - o1] - A[q]) + (A[q - o3] - A[q - o2]) + (A[q - o5] - A[q - o4]) + (A[q - o7] - A[q - o6]);
+      const Real b = (B[q - o2] - B[q]) + (B[q - o3] - B[q - o1]) + (B[q - o6] - B[q - o4]) + (B[q - o7] - B[q - o5]);
+      const Real c = (C[q - o4] - C[q]) + (C[q - o5] - C[q - o1]) + (C[q - o6] - C[q - o2]) + (C[q - o7] - C[q - o3]);
       Fr[q] -= a + b + c;
     }
   }
+}
+KERF_VECTOR_CLONES
+void cell_volume_forces(int points, const int* corner, const double* __restrict Q, int stride, int pad, double* __restrict FX,
+                        double* __restrict FY, double* __restrict FZ) {
+  cell_volume_forces_of(points, corner, Q, stride, pad, FX, FY, FZ);
+}
+KERF_VECTOR_CLONES
+void cell_volume_forces_single(int points, const int* corner, const float* __restrict Q, int stride, int pad, float* __restrict FX,
+                               float* __restrict FY, float* __restrict FZ) {
+  cell_volume_forces_of(points, corner, Q, stride, pad, FX, FY, FZ);
 }
 
 /// Gershgorin row sums of one lattice direction's springs, p in [begin, end) to p + o:
@@ -219,6 +348,23 @@ void lattice_update(int n, double h, const double* __restrict W, const double* _
   }
 }
 
+/// lattice_update with single-precision forces, fused with the single-precision copies of the
+/// new state that the next sub-step's forces read: V += (h W) F, X += (h U) V (double), then
+/// DX = X − R (the displacement from the rest position R) and VS = V in single precision.
+KERF_VECTOR_CLONES
+void lattice_update_single(int n, double h, const double* __restrict W, const double* __restrict U, const float* __restrict F,
+                           const double* __restrict R, double* __restrict X, double* __restrict V, float* __restrict DX,
+                           float* __restrict VS) {
+#pragma omp simd
+  for (int e = 0; e < n; ++e) {
+    // v ← v + h f / m;  x ← x + h v
+    V[e] += h * W[e] * static_cast<double>(F[e]);
+    X[e] += h * U[e] * V[e];
+    DX[e] = static_cast<float>(X[e] - R[e]);
+    VS[e] = static_cast<float>(V[e]);
+  }
+}
+
 } // namespace
 
 LatticeForces::LatticeForces(const SpringNetwork& net) {
@@ -279,6 +425,16 @@ LatticeForces::LatticeForces(const SpringNetwork& net) {
   m_free.assign(3 * static_cast<std::size_t>(m_points), 0.0);
   m_bound_weight.assign(static_cast<std::size_t>(m_points), 0.0);
   m_row.assign(static_cast<std::size_t>(m_points), 0.0);
+  m_rest.assign(3 * static_cast<std::size_t>(m_points), 0.0);
+  m_u_single.assign(3 * static_cast<std::size_t>(m_points), 0.0f);
+  m_v_single.assign(3 * static_cast<std::size_t>(m_points), 0.0f);
+  m_f_single.assign(3 * static_cast<std::size_t>(m_points), 0.0f);
+  m_g_single.assign(3 * static_cast<std::size_t>(m_points), 0.0f);
+  m_q_single.assign(9 * static_cast<std::size_t>(m_pad + m_points), 0.0f);
+  m_k_single.resize(m_k.size());
+  for (std::size_t e = 0; e < m_k.size(); ++e) m_k_single[e] = static_cast<float>(m_k[e]);
+  m_cell_single.resize(m_cell.size());
+  for (std::size_t e = 0; e < m_cell.size(); ++e) m_cell_single[e] = static_cast<float>(m_cell[e]);
   for (int p = 0; p < net.node_count; ++p) {
     const auto s = static_cast<std::size_t>(m_slot[static_cast<std::size_t>(p)]);
     const std::uint8_t fixed = net.constraint[static_cast<std::size_t>(p)];
@@ -295,7 +451,8 @@ LatticeForces::LatticeForces(const SpringNetwork& net) {
     for (int j = 0; j < py; ++j)
       for (int i = 0; i < px; ++i)
         for (int r = 0; r < 3; ++r)
-          m_x[static_cast<std::size_t>(r * m_points + linear(i, j, k))] = net.block.origin[r] + h * Eigen::Vector3i(i, j, k)[r];
+          m_x[static_cast<std::size_t>(r * m_points + linear(i, j, k))] = m_rest[static_cast<std::size_t>(r * m_points + linear(i, j, k))] =
+              net.block.origin[r] + h * Eigen::Vector3i(i, j, k)[r];
   m_node_count = net.node_count;
   m_topology = net.topology;
 }
@@ -309,8 +466,11 @@ void LatticeForces::gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v)
   for (int p = 0; p < m_node_count; ++p) {
     const int s = m_slot[static_cast<std::size_t>(p)];
     for (int r = 0; r < 3; ++r) {
-      m_x[static_cast<std::size_t>(r * P + s)] = x(r, p);
-      m_v[static_cast<std::size_t>(r * P + s)] = v(r, p);
+      const auto e = static_cast<std::size_t>(r * P + s);
+      m_x[e] = x(r, p);
+      m_v[e] = v(r, p);
+      m_u_single[e] = static_cast<float>(x(r, p) - m_rest[e]);
+      m_v_single[e] = static_cast<float>(v(r, p));
     }
   }
 }
@@ -318,8 +478,11 @@ void LatticeForces::gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v)
 void LatticeForces::place(int node, const Eigen::Vector3d& x, const Eigen::Vector3d& v) noexcept {
   const int s = m_slot[static_cast<std::size_t>(node)];
   for (int r = 0; r < 3; ++r) {
-    m_x[static_cast<std::size_t>(r * m_points + s)] = x[r];
-    m_v[static_cast<std::size_t>(r * m_points + s)] = v[r];
+    const auto e = static_cast<std::size_t>(r * m_points + s);
+    m_x[e] = x[r];
+    m_v[e] = v[r];
+    m_u_single[e] = static_cast<float>(x[r] - m_rest[e]);
+    m_v_single[e] = static_cast<float>(v[r]);
   }
 }
 
@@ -334,21 +497,67 @@ void LatticeForces::scatter(Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v) const noex
   }
 }
 
-double LatticeForces::substep(const SpringNetwork& net, double h) noexcept {
+double LatticeForces::substep(const SpringNetwork& net, double h, ForcePrecision precision) noexcept {
+  if (precision == ForcePrecision::single_precision) {
+    const double energy = lattice_forces_single(net);
+    lattice_update_single(3 * m_points, h, m_inverse_mass.data(), m_free.data(), m_f_single.data(), m_rest.data(), m_x.data(),
+                          m_v.data(), m_u_single.data(), m_v_single.data());
+    return energy;
+  }
   const double energy = lattice_forces(net);
   lattice_update(3 * m_points, h, m_inverse_mass.data(), m_free.data(), m_f.data(), m_x.data(), m_v.data());
   return energy;
 }
 
+double LatticeForces::lattice_forces_single(const SpringNetwork& net) noexcept {
+  const int P = m_points;
+  const float* U = m_u_single.data();
+  const float* V = m_v_single.data();
+  float* F = m_f_single.data();
+  float* G = m_g_single.data();
+  std::fill(m_f_single.begin(), m_f_single.end(), 0.0f);
+  const double h = net.block.cell_size;
+  const auto tau = static_cast<float>(net.damping_time);
+  const auto tiny = static_cast<float>(1e-12 * h);
+  double energy = 0.0;
+  for (std::size_t d = 0; d < directions.size(); ++d) {
+    const int o = m_offset[d];
+    const int begin = std::max(0, -o), end = P - std::max(0, o);
+    if (std::abs(o) >= 16) { // the end points' share in the same loop
+      energy += direction_springs_single_fused(
+          begin, end, o, static_cast<float>(h * directions[d][0]), static_cast<float>(h * directions[d][1]),
+          static_cast<float>(h * directions[d][2]), static_cast<float>(net.rest_length(m_type[d])), tau, tiny,
+          m_k_single.data() + d * static_cast<std::size_t>(P), U, U + P, U + 2 * P, V, V + P, V + 2 * P, F, F + P, F + 2 * P);
+      continue;
+    }
+    energy += direction_springs_single(begin, end, o, static_cast<float>(h * directions[d][0]), static_cast<float>(h * directions[d][1]),
+                                       static_cast<float>(h * directions[d][2]), static_cast<float>(net.rest_length(m_type[d])), tau,
+                                       tiny, m_k_single.data() + d * static_cast<std::size_t>(P), U, U + P, U + 2 * P, V, V + P,
+                                       V + 2 * P, F, F + P, F + 2 * P, G, G + P, G + 2 * P);
+    direction_ends_single(begin, end, o, G, G + P, G + 2 * P, F, F + P, F + 2 * P);
+  }
+  const double kappa = net.stiffness.volume_modulus;
+  if (kappa > 0.0) {
+    const int stride = m_pad + P;
+    energy += cell_volumes_single(P - m_pad, m_corner.data(), static_cast<float>(1.0 / (4.0 * h)), static_cast<float>(kappa * h * h * h),
+                                  tau, m_cell_single.data(), U, U + P, U + 2 * P, V, V + P, V + 2 * P, m_q_single.data(), stride,
+                                  m_pad);
+    cell_volume_forces_single(P, m_corner.data(), m_q_single.data(), stride, m_pad, F, F + P, F + 2 * P);
+  }
+  return energy;
+}
+
 double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
-                               Eigen::Matrix3Xd& f) noexcept {
+                               Eigen::Matrix3Xd& f, ForcePrecision precision) noexcept {
   if (!applies(net)) return network_forces(net, x, v, f);
   gather(x, v);
-  const double energy = lattice_forces(net);
+  const bool single = precision == ForcePrecision::single_precision;
+  const double energy = single ? lattice_forces_single(net) : lattice_forces(net);
   const int P = m_points;
   for (int p = 0; p < m_node_count; ++p) {
     const int s = m_slot[static_cast<std::size_t>(p)];
-    for (int r = 0; r < 3; ++r) f(r, p) = m_f[static_cast<std::size_t>(r * P + s)];
+    for (int r = 0; r < 3; ++r)
+      f(r, p) = single ? static_cast<double>(m_f_single[static_cast<std::size_t>(r * P + s)]) : m_f[static_cast<std::size_t>(r * P + s)];
   }
   return energy;
 }

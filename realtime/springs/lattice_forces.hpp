@@ -33,9 +33,12 @@ public:
   /// velocities v, exactly the sum network_forces computes (to round-off):
   ///   spring:  f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = (x_b − x_a)/l   (and −that on b);
   ///   volume:  f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a.
-  /// Returns the elastic energy Σ ½ k (l − L)² + Σ ½ κ V₀ (J − 1)² [J].
-  double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
-                  Eigen::Matrix3Xd& f) noexcept;
+  /// Returns the elastic energy Σ ½ k (l − L)² + Σ ½ κ V₀ (J − 1)² [J]. With
+  /// ForcePrecision::single_precision the loops run in single precision (see `substep`; after a
+  /// split the fallback is double).
+  enum class ForcePrecision { double_precision, single_precision };
+  double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& f,
+                  ForcePrecision precision = ForcePrecision::double_precision) noexcept;
 
   /// Symplectic Euler kept on the lattice between sub-steps (the arithmetic of
   /// symplectic_euler_step, without gathering and scattering the state at every sub-step):
@@ -46,8 +49,13 @@ public:
   /// and `scatter` writes x and v back. Only while `applies(net)`. Allocation-free.
   void gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
   void place(int node, const Eigen::Vector3d& x, const Eigen::Vector3d& v) noexcept;
+  /// What `substep` computes the forces in. Single precision: the same force loops on
+  /// single-precision copies of the displacements from the rest lattice (u = x − X, written
+  /// by the previous sub-step's update) and of the velocities, with the spring stretch and
+  /// J − 1 written without cancellation (l − L = (2 L·Δu + |Δu|²)/(l + L); J − 1 = tr G +
+  /// I₂(G) + det G, F = I + G); twice the SIMD lanes. Positions and velocities stay double.
   /// One sub-step on the gathered state; returns the elastic energy at its start [J].
-  double substep(const SpringNetwork& net, double h) noexcept;
+  double substep(const SpringNetwork& net, double h, ForcePrecision precision = ForcePrecision::double_precision) noexcept;
   void scatter(Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v) const noexcept;
 
   /// gershgorin_frequency_bound (symplectic_euler.hpp) at positions x [1/s²], on the lattice:
@@ -60,6 +68,8 @@ public:
 private:
   /// Forces of the gathered state into the lattice force planes; returns the elastic energy.
   double lattice_forces(const SpringNetwork& net) noexcept;
+  /// The same in single precision, from the single-precision copies into m_f_single.
+  double lattice_forces_single(const SpringNetwork& net) noexcept;
 
   std::uint64_t m_topology = 0;
   int m_node_count = -1;
@@ -78,6 +88,10 @@ private:
   std::vector<double> m_free;          ///< 3 x points: 1 on a node's free axes, else 0
   std::vector<double> m_bound_weight;  ///< points: 1/m of a node not fixed on all axes, else 0 [1/kg]
   std::vector<double> m_row;           ///< points: Gershgorin row sums [N/m]
+  std::vector<double> m_rest;          ///< 3 x points: the lattice points' rest positions [m]
+  /// ForcePrecision::single_precision: u = x − X [m], v, f, one direction's forces, the cells'
+  /// P cof(F)/(4h), the spring constants and the cell mask, in single precision.
+  std::vector<float> m_u_single, m_v_single, m_f_single, m_g_single, m_q_single, m_k_single, m_cell_single;
 };
 
 } // namespace kerf

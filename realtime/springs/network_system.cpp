@@ -1,5 +1,6 @@
 #include "realtime/springs/network_system.hpp"
 
+#include "realtime/springs/lattice_dissection.hpp"
 #include "realtime/springs/vector_clones.hpp"
 
 #include <cholmod.h>
@@ -145,11 +146,9 @@ NetworkSystem::NetworkSystem(SolvePrecision precision) : m_precision(precision) 
   cholmod_start(m_common);
   m_common->supernodal = CHOLMOD_SUPERNODAL;
   m_common->print = 0;
-  // CHOLMOD's default ordering choice (AMD; METIS only when AMD's factor is very dense). Trying
-  // METIS always (nmethods = 3) gave 11 % fewer entries in the 8³ factor and a ~10 % faster
-  // solve, but METIS's random number state is shared between threads: a study's parallel jobs
-  // then ordered differently from a serial run and its springs rows differed by 10⁻⁶
-  // (StudyRunner.ParallelRunsGiveTheSerialTablesApartFromCosts).
+  // The ordering is chosen in `rebuild`: never METIS, whose random number state is shared
+  // between threads (a study's parallel jobs ordered differently from a serial run and its
+  // springs rows differed by 10⁻⁶, StudyRunner.ParallelRunsGiveTheSerialTablesApartFromCosts).
 }
 
 NetworkSystem::NetworkSystem(const SpringNetwork& net, SolvePrecision precision) : NetworkSystem(precision) { rebuild(net); }
@@ -235,7 +234,39 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
     return s;
   };
   cholmod_sparse pattern = view(m_matrix, -1);
-  m_factor = cholmod_analyze(&pattern, m_common);
+  // Fill-reducing ordering: the lattice's geometric nested dissection (lattice_dissection.hpp;
+  // a node and its shadow take their lattice point's rank, dofs of one point stay together)
+  // against AMD, CHOLMOD keeping the one with the smaller factor. Both are deterministic; METIS
+  // (CHOLMOD's default tries it when AMD's fill is high) is not, so it is never tried.
+  std::vector<int> given;
+  {
+    const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
+    const std::vector<int> rank = lattice_nested_dissection(np);
+    std::vector<std::int64_t> key(static_cast<std::size_t>(n), -1);
+    bool on_lattice = net.block.cell_size > 0.0;
+    for (int p = 0; p < net.node_count && on_lattice; ++p) {
+      const Eigen::Vector3d g = (net.rest.col(p) - net.block.origin) / net.block.cell_size;
+      const Eigen::Vector3i gi = g.array().round().cast<int>();
+      if ((gi.array() < 0).any() || (gi.array() >= np.array()).any() || (g - gi.cast<double>()).norm() > 1e-6) {
+        on_lattice = false;
+        break;
+      }
+      const std::int64_t r = rank[static_cast<std::size_t>(gi.x() + np.x() * (gi.y() + np.y() * gi.z()))];
+      for (int i = 0; i < 3; ++i)
+        for (const int k : {natural[static_cast<std::size_t>(3 * p + i)], shadow_natural[static_cast<std::size_t>(3 * p + i)]})
+          if (k >= 0) key[static_cast<std::size_t>(k)] = r * (2 * static_cast<std::int64_t>(n)) + k;
+    }
+    if (on_lattice) {
+      given.resize(static_cast<std::size_t>(n));
+      for (int k = 0; k < n; ++k) given[static_cast<std::size_t>(k)] = k;
+      std::sort(given.begin(), given.end(), [&key](int a, int b) { return key[static_cast<std::size_t>(a)] < key[static_cast<std::size_t>(b)]; });
+    }
+  }
+  m_common->nmethods = given.empty() ? 1 : 2;
+  m_common->method[0].ordering = given.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
+  m_common->method[1].ordering = CHOLMOD_AMD;
+  m_factor = cholmod_analyze_p(&pattern, given.empty() ? nullptr : given.data(), nullptr, 0, m_common);
+  m_ordering = given.empty() || m_common->selected == 1 ? FillOrdering::amd : FillOrdering::lattice_nested_dissection;
   if (!m_factor || m_common->status < CHOLMOD_OK)
     throw std::runtime_error("NetworkSystem: CHOLMOD analysis failed (status " + std::to_string(m_common->status) + ")");
   // Numeric storage of L, and Common's workspace, allocated now rather than on the first factorisation.

@@ -41,8 +41,8 @@ public:
   NetworkSystem& operator=(const NetworkSystem&) = delete;
 
   /// Numbers the free degrees of freedom (axes not fixed by NodeConstraint) of the nodes in use,
-  /// lets CHOLMOD choose the fill-reducing ordering (AMD, or METIS/NESDIS when they give less
-  /// fill) and the supernodes on the cell-coupling pattern, and sizes every workspace that
+  /// orders them to reduce fill (the lattice's geometric nested dissection, or AMD where that
+  /// gives a smaller factor; both deterministic), lets CHOLMOD find the supernodes on the cell-coupling pattern, and sizes every workspace that
   /// `factorize` and `solve` use. Allocates; call again whenever cells, nodes or constraints
   /// change (a tear).
   ///
@@ -59,6 +59,11 @@ public:
   /// False if the system is not tear-ready or a split does not fit the shadows (a second copy of
   /// a vertex, a changed constraint): then `rebuild` is needed.
   bool bind_split_vertices(const SpringNetwork& net) noexcept;
+
+  /// The fill-reducing ordering `rebuild` chose: the lattice's nested dissection, or AMD when
+  /// that gave the smaller factor (or a node is off the block's lattice).
+  enum class FillOrdering { lattice_nested_dissection, amd };
+  [[nodiscard]] FillOrdering fill_ordering() const { return m_ordering; }
 
   /// Number of free degrees of freedom.
   [[nodiscard]] int dof_count() const { return static_cast<int>(m_matrix.rows()); }
@@ -117,6 +122,7 @@ private:
   std::vector<float> m_inverse_diagonal_single, m_solution_single, m_below_single, m_dots_single;
   std::vector<double> m_update_buffer; ///< CHOLMOD's supernode update workspace (see factorize)
   bool m_factorized = false;
+  FillOrdering m_ordering = FillOrdering::amd;
 };
 
 } // namespace kerf

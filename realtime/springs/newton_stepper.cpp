@@ -10,8 +10,8 @@ NewtonStepper::NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterat
     : m_mode(mode), m_max_iterations(max_iterations),
       // Backward Euler's A = M/h² + … is well conditioned (the mass term), so its kept factor is
       // read in single precision; the quasi-static K_T (regularised by 10⁻⁸ M only) is not.
-      m_system(mode == Mode::implicit_euler ? NetworkSystem::SolvePrecision::single_precision
-                                            : NetworkSystem::SolvePrecision::double_precision),
+      m_system(mode != Mode::quasi_static ? NetworkSystem::SolvePrecision::single_precision
+                                          : NetworkSystem::SolvePrecision::double_precision),
       m_tolerance_ratio(relative_tolerance), m_tear_ready(tear_ready) {
   if (max_iterations < 1) throw std::invalid_argument("NewtonStepper: max_iterations must be >= 1");
   if (!(relative_tolerance > 0.0)) throw std::invalid_argument("NewtonStepper: the relative tolerance must be > 0");
@@ -63,7 +63,7 @@ void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
 }
 
 bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
-  if (m_mode == Mode::implicit_euler)
+  if (m_mode != Mode::quasi_static)
     m_system.assemble(net, x, 1.0 / (dt * dt), 1.0 + net.damping_time / dt);
   else
     m_system.assemble(net, x, m_static_regularisation, 1.0);
@@ -71,10 +71,10 @@ bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x
   return m_system.factorize();
 }
 
-double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
-                               double dt) noexcept {
+double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
+                               LatticeForces::ForcePrecision precision) noexcept {
   // Over the free entries only (entry e = 3 p + i of the 3 x capacity arrays, dof d, mass m).
-  const bool implicit = m_mode == Mode::implicit_euler;
+  const bool implicit = m_mode != Mode::quasi_static;
   const double* X = x.data();
   const double* X0 = m_x0.data();
   const double* V0 = m_v0.data();
@@ -87,7 +87,7 @@ double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd&
   else
     for (int k = 0; k < m_free_count; ++k) V[m_free_entry[static_cast<std::size_t>(k)]] = 0.0;
   // Quasi-static equilibrium has no damping: forces at zero velocity.
-  m_forces.evaluate(net, x, implicit ? v : m_zero, m_f);
+  m_forces.evaluate(net, x, implicit ? v : m_zero, m_f, precision);
   const double* F = m_f.data();
   double norm = 0.0;
   for (int k = 0; k < m_free_count; ++k) {
@@ -107,15 +107,16 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
   const int n = net.node_count;
   m_x0.leftCols(n) = x.leftCols(n);
   m_v0.leftCols(n) = v.leftCols(n);
+  const bool implicit = m_mode != Mode::quasi_static;
   // Warm start: the implicit step starts from the explicit predictor xₙ + h vₙ.
-  if (m_mode == Mode::implicit_euler)
+  if (implicit)
     for (int k = 0; k < m_free_count; ++k) {
       const int e = m_free_entry[static_cast<std::size_t>(k)];
       x.data()[e] += dt * v.data()[e];
     }
   // `fresh`: the kept factorisation was computed at the current iterate.
   bool fresh = false;
-  if (m_mode == Mode::implicit_euler ? m_factor_dt != dt : m_factor_dt < 0.0) {
+  if (implicit ? m_factor_dt != dt : m_factor_dt < 0.0) {
     if (!refactor(net, x, dt)) {
       report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
       return report;
@@ -124,7 +125,53 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
     fresh = true;
   }
   const double tolerance = m_tolerance_ratio * net.stiffness.edge * net.block.cell_size;
-  double norm = residual(net, x, v, dt);
+  // Backward Euler's predictor residual only sets the first Newton step (an approximate one
+  // already: the kept factor, read in single precision), so its forces are evaluated in single
+  // precision; every residual that decides convergence or a line-search step is double.
+  double norm = residual(net, x, v, dt,
+                         implicit ? LatticeForces::ForcePrecision::single_precision : LatticeForces::ForcePrecision::double_precision);
+  if (m_mode == Mode::implicit_euler && norm <= tolerance) norm = residual(net, x, v, dt); // converged already: decide in double
+  if (m_mode == Mode::linearly_implicit_euler) {
+    // A kept factorisation that no longer approximates the Jacobian lets a mode grow from
+    // sample to sample (the step's error (I − A_kept⁻¹ A) e is amplified). Every
+    // `linearised_check_interval`-th call the residual after the step is evaluated too, and if
+    // the step reduced it by less than 4 x (modified Newton's criterion) the factorisation is
+    // refreshed at the next call's predictor.
+    if (m_refresh_pending && !fresh) {
+      if (!refactor(net, x, dt)) {
+        // A not positive definite at x*: no step this sample (the state stays at the predictor,
+        // reported unconverged), the refresh is tried again at the next.
+        for (int k = 0; k < m_free_count; ++k) {
+          const int e = m_free_entry[static_cast<std::size_t>(k)];
+          v.data()[e] = (x.data()[e] - m_x0.data()[e]) / dt;
+        }
+        report.residual = norm;
+        return report;
+      }
+      ++report.factorisations;
+    }
+    m_refresh_pending = false;
+    // x = x* − A⁻¹ r(x*), v = (x − xₙ)/h: one linear solve.
+    m_system.solve(m_r, m_dx);
+    for (int k = 0; k < m_free_count; ++k) {
+      const int e = m_free_entry[static_cast<std::size_t>(k)];
+      x.data()[e] -= m_dx[m_free_dof[static_cast<std::size_t>(k)]];
+    }
+    report.iterations = 1;
+    report.residual = norm;
+    if (++m_calls_since_check >= linearised_check_interval) {
+      m_calls_since_check = 0;
+      report.residual = residual(net, x, v, dt); // also sets v
+      m_refresh_pending = report.residual > tolerance && report.residual > 0.25 * norm;
+    } else {
+      for (int k = 0; k < m_free_count; ++k) {
+        const int e = m_free_entry[static_cast<std::size_t>(k)];
+        v.data()[e] = (x.data()[e] - m_x0.data()[e]) / dt;
+      }
+    }
+    report.converged = x.leftCols(n).allFinite();
+    return report;
+  }
   double previous = INFINITY;
   while (report.iterations < m_max_iterations && norm > tolerance) {
     if (!fresh && norm > 0.25 * previous) { // the kept factorisation no longer converges fast: refresh it

@@ -22,11 +22,26 @@ struct NewtonReport {
 
 class NewtonStepper {
 public:
+  /// Linearly implicit Euler: the residual after the step is checked on every 8th call.
+  static constexpr int linearised_check_interval = 8;
+
   enum class Mode {
     /// Backward Euler: M (x − xₙ − h vₙ)/h² = f(x, (x − xₙ)/h), v = (x − xₙ)/h.
     implicit_euler,
     /// Static equilibrium f(x, 0) = 0 per call (inertia and damping left out), v = 0.
-    quasi_static
+    quasi_static,
+    /// Linearly implicit (linearised backward) Euler, Baraff & Witkin, "Large steps in cloth
+    /// simulation", SIGGRAPH 1998, §4: backward Euler's equation linearised at the predictor
+    /// x* = xₙ + h vₙ and solved once, x = x* − A⁻¹ r(x*), v = (x − xₙ)/h, with A the kept
+    /// factorisation (refreshed when dt changes, after a tear, and at the next call's x* when a
+    /// check finds it stale: every `linearised_check_interval`-th call also evaluates the
+    /// residual after the step, and a step that reduced it by less than 4 x (modified Newton's
+    /// criterion) marks it so; with a stale A a mode grows from sample to sample). One force
+    /// evaluation and one pair of triangular solves per call (a second evaluation on check
+    /// calls); otherwise the residual after the step is not evaluated, so `forces()` keeps the
+    /// forces at the predictor and the report is `converged` by definition (its `residual` is
+    /// the predictor's, or after the step on check calls).
+    linearly_implicit_euler
   };
 
   /// Builds the system's pattern for `net` (allocates). `max_iterations` >= 1 per advance;
@@ -54,12 +69,13 @@ public:
 
   /// The internal forces at the state the last `advance` returned (at its velocities, or at
   /// zero velocity quasi-statically) [N], 3 x capacity: the residual's own evaluation, so the
-  /// caller need not recompute them.
+  /// caller need not recompute them. Linearly implicit: the forces at the predictor x*.
   [[nodiscard]] const Eigen::Matrix3Xd& forces() const { return m_f; }
 
 private:
   bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
-  double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+  double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
+                  LatticeForces::ForcePrecision precision = LatticeForces::ForcePrecision::double_precision) noexcept;
   /// The free entries (3 p + i with a dof) in node order, their dofs and node masses, from the
   /// system's numbering (after rebuild and after binding splits). Allocation-free.
   void bind_free_entries(const SpringNetwork& net) noexcept;
@@ -72,6 +88,8 @@ private:
   bool m_tear_ready = false;
   double m_factor_dt = -1.0;
   double m_static_regularisation = 0.0;
+  bool m_refresh_pending = false; ///< linearly implicit: the last check found the kept factorisation stale
+  int m_calls_since_check = 0;    ///< linearly implicit: calls since the residual after the step was last checked
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
   Eigen::VectorXd m_r, m_dx;
   int m_free_count = 0;

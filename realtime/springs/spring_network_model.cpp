@@ -17,6 +17,7 @@ std::string_view to_string(SpringIntegrator integrator) {
   case SpringIntegrator::symplectic_euler: return "explicit";
   case SpringIntegrator::implicit_euler: return "implicit";
   case SpringIntegrator::quasi_static: return "static";
+  case SpringIntegrator::linearly_implicit_euler: return "linear-implicit";
   }
   return "explicit";
 }
@@ -25,6 +26,7 @@ std::optional<SpringIntegrator> spring_integrator_from_string(std::string_view n
   if (name == "explicit") return SpringIntegrator::symplectic_euler;
   if (name == "implicit") return SpringIntegrator::implicit_euler;
   if (name == "static") return SpringIntegrator::quasi_static;
+  if (name == "linear-implicit") return SpringIntegrator::linearly_implicit_euler;
   return std::nullopt;
 }
 
@@ -262,6 +264,13 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   m_attached.clear();
   for (int p = 0; p < net.node_count; ++p)
     if (m_attached_to[static_cast<std::size_t>(p)] >= 0) m_attached.push_back(p);
+  m_tool_cells.clear();
+  for (int cell = 0; cell < net.cell_count(); ++cell)
+    for (const int p : net.cell_nodes[static_cast<std::size_t>(cell)])
+      if (m_attached_to[static_cast<std::size_t>(p)] >= 0) {
+        m_tool_cells.push_back(cell);
+        break;
+      }
   m_excluded.assign(static_cast<std::size_t>(net.node_capacity()), 0);
   for (int p = 0; p < net.node_count; ++p) m_excluded[static_cast<std::size_t>(p)] = m_attached_to[static_cast<std::size_t>(p)] >= 0;
 
@@ -296,6 +305,9 @@ void SpringNetworkModel::reset() {
     m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::implicit_euler, 8, newton_tolerance, m_setup.tearing);
   else if (m_setup.integrator == SpringIntegrator::quasi_static)
     m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::quasi_static, 30, newton_tolerance, m_setup.tearing);
+  else if (m_setup.integrator == SpringIntegrator::linearly_implicit_euler)
+    m_newton = std::make_unique<NewtonStepper>(m_net, NewtonStepper::Mode::linearly_implicit_euler, 1, newton_tolerance,
+                                               m_setup.tearing);
   m_tearing = m_setup.tearing ? std::make_unique<VertexTearing>(m_net, m_setup.tensile_limit) : nullptr;
 }
 
@@ -348,7 +360,8 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
       for (int k = 1; k <= substeps; ++k) {
         place_attached(static_cast<double>(k) / substeps);
         for (const int p : m_attached) m_lattice.place(p, m_x.col(p), m_v.col(p));
-        m_lattice.substep(m_net, h);
+        m_lattice.substep(m_net, h, m_setup.single_precision_forces ? LatticeForces::ForcePrecision::single_precision
+                                                                    : LatticeForces::ForcePrecision::double_precision);
       }
       m_lattice.scatter(m_x, m_v);
     } else {
@@ -367,16 +380,32 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
   }
   for (int t = 0; t < n_tools; ++t) m_last_tool[static_cast<std::size_t>(t)] = tools[static_cast<std::size_t>(t)].position;
 
-  // The force on each stylus: the sum of the internal forces on its attached nodes (at the end
-  // of the sample; the Newton stepper's last residual evaluation already holds them).
-  if (m_newton)
-    m_f.leftCols(m_net.node_count) = m_newton->forces().leftCols(m_net.node_count);
-  else
-    m_lattice.evaluate(m_net, m_x, m_v, m_f);
+  // The force on each stylus: the sum of the internal forces on its attached nodes at the end
+  // of the sample. The Newton stepper's last residual evaluation already holds them; the
+  // explicit and the linearly implicit steps evaluate none at the end state, so there the
+  // forces of the cells holding attached nodes (every spring and volume term acting on such a
+  // node) are summed alone, instead of the whole network's.
+  const bool from_newton = m_newton && m_setup.integrator != SpringIntegrator::linearly_implicit_euler;
+  if (from_newton) m_f.leftCols(m_net.node_count) = m_newton->forces().leftCols(m_net.node_count);
   bool finite = m_x.leftCols(m_net.node_count).allFinite();
   for (int t = 0; t < n_tools; ++t) forces[static_cast<std::size_t>(t)] = ForceSample{Eigen::Vector3d::Zero(), InteractionMode::deformation_1, 0.0, over_budget};
-  for (int p = 0; p < m_net.node_count; ++p)
-    if (const int t = m_attached_to[static_cast<std::size_t>(p)]; t >= 0) forces[static_cast<std::size_t>(t)].force += m_f.col(p);
+  if (!from_newton) {
+    Eigen::Matrix<double, 3, 8> xc, vc, fc;
+    for (const int cell : m_tool_cells) {
+      const auto& nodes = m_net.cell_nodes[static_cast<std::size_t>(cell)];
+      for (int a = 0; a < 8; ++a) {
+        xc.col(a) = m_x.col(nodes[static_cast<std::size_t>(a)]);
+        vc.col(a) = m_v.col(nodes[static_cast<std::size_t>(a)]);
+      }
+      cell_forces(m_net, cell, xc, vc, fc);
+      for (int a = 0; a < 8; ++a)
+        if (const int t = m_attached_to[static_cast<std::size_t>(nodes[static_cast<std::size_t>(a)])]; t >= 0)
+          forces[static_cast<std::size_t>(t)].force += fc.col(a);
+    }
+  } else {
+    for (int p = 0; p < m_net.node_count; ++p)
+      if (const int t = m_attached_to[static_cast<std::size_t>(p)]; t >= 0) forces[static_cast<std::size_t>(t)].force += m_f.col(p);
+  }
 
   if (m_tearing && finite && m_tearing->tear(m_net, m_x, m_v, m_excluded)) {
     ++m_tears;

@@ -23,9 +23,12 @@ namespace kerf {
 enum class SpringIntegrator {
   symplectic_euler, ///< explicit, sub-stepped under the computed stability limit
   implicit_euler,   ///< backward Euler by Newton with a kept sparse LDLᵀ factorisation
-  quasi_static      ///< static equilibrium per sample (for comparison with the reference)
+  quasi_static,     ///< static equilibrium per sample (for comparison with the reference)
+  /// linearly implicit Euler (Baraff & Witkin 1998): backward Euler's Newton iteration taken
+  /// once per sample from the predictor, with the kept factorisation, no residual check
+  linearly_implicit_euler
 };
-/// "explicit", "implicit", "static".
+/// "explicit", "implicit", "static", "linear-implicit".
 std::string_view to_string(SpringIntegrator integrator);
 std::optional<SpringIntegrator> spring_integrator_from_string(std::string_view name);
 
@@ -64,6 +67,10 @@ struct SpringNetworkSetup {
   int cells = 8;                ///< N: cells per side of the block (>= 1)
   double cell_size = 0.0;       ///< h [m]; 0: the block side over N (see the constructor)
   SpringIntegrator integrator = SpringIntegrator::symplectic_euler;
+  /// Symplectic Euler's force loops in single precision while the network is untorn
+  /// (LatticeForces::ForcePrecision; positions and velocities stay double): 1.6 x faster at 8³,
+  /// clay_pull's profile within 1.4·10⁻⁷ of its peak of the double loops' (docs/spring-network.md §6).
+  bool single_precision_forces = true;
   bool tearing = false;
   double tensile_limit = 0.0;   ///< σ_max [Pa] > 0 when tearing
   /// Grasp radius [m]: network nodes within it of a stylus tip centre are attached to the stylus;
@@ -127,6 +134,10 @@ private:
   SpringNetwork m_initial, m_net;
   std::vector<int> m_attached_to;        ///< per node: stylus index or -1
   std::vector<int> m_attached;           ///< the nodes attached to a stylus, in node order (never split)
+  /// The cells with an attached corner (attached nodes are never split, so the cells holding
+  /// them stay the same): the explicit and linearly implicit integrators sum their forces on
+  /// the tools.
+  std::vector<int> m_tool_cells;
   std::vector<double> m_gap;             ///< per node attached to a blade: its gap g [m]
   std::vector<std::uint8_t> m_excluded;  ///< per node: not torn (attached)
   Eigen::Matrix3Xd m_x, m_v, m_f;

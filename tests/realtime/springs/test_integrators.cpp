@@ -1,6 +1,7 @@
 // The three integrators on small networks: energy conservation and the computed stability limit
 // of symplectic Euler (against the measured one), unconditional boundedness of implicit Euler.
 
+#include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/newton_stepper.hpp"
 #include "realtime/springs/symplectic_euler.hpp"
 #include "tests/realtime/springs/network_fixtures.hpp"
@@ -113,6 +114,33 @@ TEST(SymplecticEuler, ConservesEnergyWithoutDamping) {
   }
 }
 
+TEST(SymplecticEuler, SinglePrecisionForcesConserveEnergyWithoutDamping) {
+  // The lattice sub-steps with single-precision force loops (the explicit integrator's default):
+  // no drift over 10⁵ steps either (the energy's window means, every 10th step sampled).
+  for (const bool supported : {false, true}) {
+    Perturbed p = perturbed_block(supported);
+    const double limit = symplectic_euler_stability_limit(highest_angular_frequency(p.net), 0.0);
+    const double h = 0.1 * limit;
+    const double e0 = total_energy(p.net, p.x, p.v);
+    LatticeForces lattice(p.net);
+    ASSERT_TRUE(lattice.applies(p.net));
+    lattice.gather(p.x, p.v);
+    double max_deviation = 0.0, first_window = 0.0, last_window = 0.0;
+    const int steps = 100000, window = 5000;
+    for (int s = 0; s < steps; ++s) {
+      lattice.substep(p.net, h, LatticeForces::ForcePrecision::single_precision);
+      if (s % 10 != 0) continue;
+      lattice.scatter(p.x, p.v);
+      const double e = total_energy(p.net, p.x, p.v);
+      max_deviation = std::max(max_deviation, std::abs(e - e0) / e0);
+      if (s < window) first_window += e / (window / 10);
+      if (s >= steps - window) last_window += e / (window / 10);
+    }
+    EXPECT_LT(max_deviation, 0.2);
+    EXPECT_LT(std::abs(last_window - first_window) / e0, 1e-3);
+  }
+}
+
 /// Runs `steps` steps of size h and returns the largest energy over the initial one.
 double energy_growth(double h_over_limit, bool supported, int steps) {
   Perturbed p = perturbed_block(supported);
@@ -161,6 +189,23 @@ TEST(ImplicitEuler, BoundedFarBeyondTheExplicitLimit) {
       // Backward Euler dissipates: the energy never rises above the initial one.
       EXPECT_LE(total_energy(p.net, p.x, p.v), e0 * (1.0 + 1e-9)) << "step " << s;
     }
+  }
+}
+
+TEST(LinearlyImplicitEuler, BoundedFarBeyondTheExplicitLimit) {
+  // The same settings for the linearised step (one solve with the factor kept from the first
+  // step, no residual check): bounded, and it comes to rest like backward Euler.
+  for (const double stiffness_scale : {1.0, 1e6}) {
+    Perturbed p = perturbed_block(true, stiffness_scale);
+    const double limit = symplectic_euler_stability_limit(highest_angular_frequency(p.net), 0.0);
+    const double dt = stiffness_scale > 1.0 ? 1e-3 : 100.0 * limit;
+    NewtonStepper stepper(p.net, NewtonStepper::Mode::linearly_implicit_euler, 1);
+    const double e0 = total_energy(p.net, p.x, p.v);
+    for (int s = 0; s < 500; ++s) {
+      stepper.advance(p.net, p.x, p.v, dt);
+      ASSERT_LE(total_energy(p.net, p.x, p.v), e0 * (1.0 + 1e-6)) << "step " << s;
+    }
+    EXPECT_LT(total_energy(p.net, p.x, p.v), 1e-3 * e0);
   }
 }
 

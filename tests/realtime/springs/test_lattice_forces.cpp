@@ -155,6 +155,33 @@ TEST(LatticeForces, SubstepsEqualSymplecticEulerSteps) {
   EXPECT_GT((x - s.x).leftCols(n).cwiseAbs().maxCoeff(), 1e-6); // it did move
 }
 
+TEST(LatticeForces, SinglePrecisionSubstepsFollowTheDoubleOnes) {
+  // The same moving, damped trajectory as above with the force loops in single precision
+  // (positions and velocities in double): it follows symplectic_euler_step's double-precision
+  // trajectory to the single-precision round-off of the forces (~10⁻⁷ relative per sub-step).
+  Scattered s = constrained_block(3);
+  const double h = 0.5 * symplectic_euler_stability_limit(highest_angular_frequency(s.net), s.net.damping_time);
+  LatticeForces lattice(s.net);
+  Eigen::Matrix3Xd x = s.x, v = s.v, f(3, s.net.node_capacity());
+  const int fixed = 0;
+  lattice.gather(s.x, s.v);
+  for (int k = 1; k <= 200; ++k) {
+    const Eigen::Vector3d target = s.net.rest.col(fixed) + Eigen::Vector3d(0, 0, 1e-5 * k), rate(0, 0, 1e-5 / h);
+    x.col(fixed) = target, v.col(fixed) = rate;
+    symplectic_euler_step(s.net, x, v, h, f);
+    lattice.place(fixed, target, rate);
+    lattice.substep(s.net, h, LatticeForces::ForcePrecision::single_precision);
+  }
+  Eigen::Matrix3Xd y(3, s.net.node_capacity()), w(3, s.net.node_capacity());
+  lattice.scatter(y, w);
+  const int n = s.net.node_count;
+  const double moved = (x - s.net.rest).leftCols(n).cwiseAbs().maxCoeff();
+  const double deviation = (y - x).leftCols(n).cwiseAbs().maxCoeff();
+  EXPECT_LT(deviation, 1e-5 * moved);
+  EXPECT_GT(deviation, 0.0); // the single-precision path was taken
+  EXPECT_LT((w - v).leftCols(n).cwiseAbs().maxCoeff(), 1e-4 * v.leftCols(n).cwiseAbs().maxCoeff());
+}
+
 TEST(NetworkSystem, SolvesAgainstADenseFactorisation) {
   // A = M/h² + K_T at a displaced state of the pruned block (two corner nodes fixed), solved by
   // the supernodal solves on CHOLMOD's factor (double) and on its single-precision copy, against

@@ -46,7 +46,8 @@ TEST(RealtimeContract, SpringNetworkStepAllocatesNothing) {
 
   const TetMesh mesh = test::clay_pull_mesh();
   for (const SpringIntegrator integrator :
-       {SpringIntegrator::symplectic_euler, SpringIntegrator::implicit_euler, SpringIntegrator::quasi_static}) {
+       {SpringIntegrator::symplectic_euler, SpringIntegrator::implicit_euler, SpringIntegrator::quasi_static,
+        SpringIntegrator::linearly_implicit_euler}) {
     SpringNetworkModel model(mesh, test::clay_pull_setup(integrator));
     std::vector<std::vector<ToolState>> path(301, std::vector<ToolState>(1));
     for (int k = 0; k <= 300; ++k) path[static_cast<std::size_t>(k)][0].position = {0.02, 0.0, 0.022 + 5e-6 * std::min(k, 200)};
@@ -70,7 +71,8 @@ TEST(RealtimeContract, BladePressAllocatesNothing) {
 }
 
 TEST(RealtimeContract, TearingAllocatesNothing) {
-  for (const SpringIntegrator integrator : {SpringIntegrator::symplectic_euler, SpringIntegrator::implicit_euler}) {
+  for (const SpringIntegrator integrator :
+       {SpringIntegrator::symplectic_euler, SpringIntegrator::implicit_euler, SpringIntegrator::linearly_implicit_euler}) {
   // clay_tear: 60 x 20 x 20 mm on a table, styluses at x = 15 and 45 mm pulled 10 mm apart each.
   // The implicit integrator takes each split into its tear-ready pattern (no new analysis).
   const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.06, 0.01, 0.02}, 12, 4, 4);
