@@ -93,7 +93,7 @@ void add_run_command(CLI::App& app) {
   run->add_option("scene", options->scene, "scene file or name")->required();
   run->add_option("--model", options->model, "model name (see `kerf models`)")->required();
   run->add_option("-o,--output", options->out, "output directory (default runs/SCENE/MODEL)");
-  run->add_option("--integrator", options->integrator, "time integrator of models that take one (springs: explicit|implicit|static)");
+  run->add_option("--integrator", options->integrator, "time integrator of models that take one (springs: explicit|explicit-double|implicit|linear-implicit|static)");
   run->add_option("--trajectory", options->trajectory, "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   run->callback([options] { run_run(*options); });
 }

@@ -155,22 +155,31 @@ void require_springs_inputs(const Scene& scene) {
                         "which scene " + scene.name + " gives");
 }
 
+namespace {
+
+/// Sets the integrator named `name` (a scene's [models.springs] integrator or `--integrator`):
+/// "explicit-double" is symplectic Euler with its force loops in double precision ("explicit":
+/// single precision, the default).
+void set_integrator(SpringNetworkSetup& setup, const std::string& name) {
+  const bool double_forces = name == "explicit-double";
+  const auto integrator = double_forces ? SpringIntegrator::symplectic_euler : spring_integrator_from_string(name);
+  if (!integrator)
+    throw std::invalid_argument("model springs: integrator \"" + name +
+                                "\" is not one of explicit, explicit-double, implicit, linear-implicit, static");
+  setup.integrator = *integrator;
+  setup.single_precision_forces = !double_forces;
+}
+
+} // namespace
+
 BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const ModelOptions& options) {
   SpringNetworkSetup setup;
   const SpringsModelSettings settings = scene.springs.value_or(SpringsModelSettings{});
-  if (settings.integrator) setup.integrator = *spring_integrator_from_string(*settings.integrator);
+  if (settings.integrator) set_integrator(setup, *settings.integrator);
   for (const auto& [key, value] : options) {
     if (key != "integrator")
       throw std::invalid_argument("model springs: unknown option \"" + key + "\" (known: integrator)");
-    // "explicit-double": symplectic Euler with its force loops in double precision ("explicit":
-    // single precision, the default).
-    const bool double_forces = value == "explicit-double";
-    const auto integrator = double_forces ? SpringIntegrator::symplectic_euler : spring_integrator_from_string(value);
-    if (!integrator)
-      throw std::invalid_argument("model springs: integrator \"" + value +
-                                  "\" is not one of explicit, explicit-double, implicit, linear-implicit, static");
-    setup.integrator = *integrator;
-    setup.single_precision_forces = !double_forces;
+    set_integrator(setup, value);
   }
   const Material& m = scene.material;
   // A calibrated scene scales the modulus the spring constants are identified from ([models.springs]).

@@ -758,8 +758,10 @@ private:
       }
     }
     if (const auto integrator = optional_string(t, "integrator")) {
-      if (*integrator != "explicit" && *integrator != "implicit" && *integrator != "static")
-        wrong(*t.find("integrator"), t, t.key("integrator"), "\"explicit\", \"implicit\" or \"static\"");
+      if (*integrator != "explicit" && *integrator != "explicit-double" && *integrator != "implicit" &&
+          *integrator != "linear-implicit" && *integrator != "static")
+        wrong(*t.find("integrator"), t, t.key("integrator"),
+              "\"explicit\", \"explicit-double\", \"implicit\", \"linear-implicit\" or \"static\"");
       s.integrator = *integrator;
     }
     if (const toml::node* n = t.find("volume_term")) {
