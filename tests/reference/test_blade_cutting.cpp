@@ -100,5 +100,81 @@ TEST(BladeCutting, SteadyCuttingForceIsToughnessTimesContactLength) {
   fs::remove_all(dir);
 }
 
+// potato_wedge_cut (tri_prism.geo: base b = 18 mm, apex d_a = 17 mm above it, h = 2 mm, P1): the
+// blade enters the apex line, so the contact length grows with the depth d below the apex,
+// l(d) = b d/d_a (paper 001 §5.1, Fig. 8), and Eq. 10 says the force grows with it, f = J_c l(d).
+// Same route as above (σ_c = 1 MPa, 0.5 mm blade). Expected values:
+//   work     W(d_0 → d_1) = J_c ∫ l dd = J_c b (d_1² − d_0²)/(2 d_a)       (Eq. 10 integrated)
+//   fracture the dissipation density behind the edge is φ_d(κ) = J_c κ/δ_f on the softening branch
+//            (reference/cohesive/cohesive_law.hpp, δ_0 ≪ δ_f), and the flanks open the faces to
+//            κ = 2 s tan(θ/2) at a distance s behind the edge, which fails at s_f = δ_f/(2 tan(θ/2));
+//            so the dissipated area trails the edge by s_f/2 on average:
+//            D(d_0 → d_1) = J_c b ((d_1 − s_f/2)² − (d_0 − s_f/2)²)/(2 d_a).
+// With 2 mm elements the sampled force saw-tooths as the crack front crosses elements, so the force
+// is compared through the work over 3 mm windows.
+TEST(BladeCutting, WedgeForceGrowsWithTheContactLength) {
+  namespace fs = std::filesystem;
+  Scene scene = read_scene(fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / "potato_wedge_cut.toml");
+  ASSERT_EQ(scene.tools.size(), 1u);
+  scene.material.cohesive_strength = 1e6;       // δ_f = 0.4 mm
+  scene.tools.front().blade.thickness = 0.5e-3; // > δ_f
+  const TetMesh mesh = scene_mesh(scene);
+  const double b = scene.geometry.parameters.at("base_width"), apex = scene.geometry.parameters.at("depth");
+  const double Jc = scene.material.fracture_toughness;
+  const double delta_f = 2.0 * Jc / scene.material.cohesive_strength;
+  const double s_f = delta_f / (2.0 * std::tan(0.5 * scene.tools.front().blade.wedge_angle));
+
+  // Every 0.25 mm of blade travel: the 1 mm approach and 12 mm below the apex (t = 13 s).
+  ReferenceRunSettings settings;
+  settings.fracture = ReferenceFracture::on;
+  settings.write_fields = false;
+  settings.checkpoint_every = 1000;
+  for (std::size_t k = 0; k <= 13000; k += 250) settings.sample_indices.push_back(k);
+  const fs::path dir = fs::temp_directory_path() / "kerf_test_wedge_cutting";
+  fs::remove_all(dir);
+  const ForceProfile profile = run_reference(scene, mesh, settings, dir);
+  ASSERT_EQ(profile.rows.size(), settings.sample_indices.size()) << "the load path stopped";
+
+  nlohmann::json manifest;
+  std::ifstream(dir / "manifest.json") >> manifest;
+  const auto& samples = manifest.at("samples");
+  // The sample with the blade edge d below the apex: the edge touches it at t = 1 s, then moves at
+  // 1 mm/s (the scene's trajectory).
+  auto at_depth = [&](double d) -> const nlohmann::json& {
+    const double t = 1.0 + d / 1e-3;
+    for (const auto& s : samples)
+      if (std::abs(s.at("t_s").get<double>() - t) < 1e-9) return s;
+    throw std::runtime_error("no sample at depth " + std::to_string(d));
+  };
+  auto energy = [&](double d, const char* key) { return at_depth(d).at("energy").at(key).get<double>(); };
+  auto work_ratio = [&](double d0, double d1) {
+    return (energy(d1, "external_work_J") - energy(d0, "external_work_J")) / (Jc * b * (d1 * d1 - d0 * d0) / (2.0 * apex));
+  };
+  auto mean_work_rate = [&](double d0, double d1) {
+    return (energy(d1, "external_work_J") - energy(d0, "external_work_J")) / (d1 - d0);
+  };
+  const double w1 = work_ratio(3e-3, 6e-3), w2 = work_ratio(6e-3, 9e-3), w3 = work_ratio(9e-3, 12e-3);
+  const double w_all = work_ratio(3e-3, 12e-3);
+  const double trailing = 0.5 * s_f;
+  const double dissipation_ratio = (energy(12e-3, "cohesive_dissipation_J") - energy(3e-3, "cohesive_dissipation_J")) /
+                                   (Jc * b * ((12e-3 - trailing) * (12e-3 - trailing) - (3e-3 - trailing) * (3e-3 - trailing)) /
+                                    (2.0 * apex));
+  const double rate_ratio = mean_work_rate(9e-3, 12e-3) / mean_work_rate(3e-3, 6e-3);
+  const double length_ratio = (9e-3 + 12e-3) / (3e-3 + 6e-3); // mean l over 9–12 mm against 3–6 mm
+  std::printf("wedge: W/(J_c ∫l) 3-6 mm %.3f, 6-9 mm %.3f, 9-12 mm %.3f, 3-12 mm %.3f; D against the trailing "
+              "estimate %.3f; mean force 9-12 / 3-6 mm %.3f (l ratio %.3f)\n",
+              w1, w2, w3, w_all, dissipation_ratio, rate_ratio, length_ratio);
+  // Eq. 10 with l(d): the mean force over the cut is J_c l(d) (10%), and so is each 3 mm stretch
+  // (20%, one and a half elements each), while l grows from 3 to 13 mm.
+  EXPECT_NEAR(w_all, 1.0, 0.10);
+  for (const double w : {w1, w2, w3}) EXPECT_NEAR(w, 1.0, 0.20);
+  EXPECT_NEAR(rate_ratio / length_ratio, 1.0, 0.20);
+  // The fracture work follows the faces the flanks open (5%).
+  EXPECT_NEAR(dissipation_ratio, 1.0, 0.05);
+  EXPECT_EQ(profile.rows.back().mode, InteractionMode::cutting);
+  EXPECT_LT(std::abs(manifest.at("energy").at("balance_error").get<double>()), 0.02);
+  fs::remove_all(dir);
+}
+
 } // namespace
 } // namespace kerf
