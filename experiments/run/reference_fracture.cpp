@@ -43,7 +43,13 @@ CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem&
   info.interface_triangles = static_cast<std::size_t>(split.plus_faces.rows());
   info.zone_length = reference::cohesive_zone_length(scene.material.youngs_modulus, scene.material.poisson_ratio,
                                                      scene.material.fracture_toughness, scene.material.cohesive_strength);
-  info.element_size = scene.geometry.element_size / std::pow(2.0, refinements);
+  // The element size on the crack path: the scene's, or the finer size its geometry grades the cut
+  // plane to (rect_prism.geo's cut_element_size), halved by each refinement.
+  double crack_path_size = scene.geometry.element_size;
+  if (const auto graded = scene.geometry.parameters.find("cut_element_size");
+      graded != scene.geometry.parameters.end() && graded->second > 0.0)
+    crack_path_size = std::min(crack_path_size, graded->second);
+  info.element_size = crack_path_size / std::pow(2.0, refinements);
   info.elements_in_zone = reference::elements_in_cohesive_zone(info.zone_length, info.element_size);
   if (info.elements_in_zone < reference::minimum_elements_in_cohesive_zone) {
     char buf[512];

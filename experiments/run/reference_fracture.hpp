@@ -30,7 +30,8 @@ struct CrackPathInfo {
   bool active = false;
   std::size_t interface_triangles = 0; ///< crack triangles joined by the cohesive law
   double zone_length = 0.0;           ///< l_cz [m] (reference/cohesive/cohesive_zone.hpp)
-  double element_size = 0.0;          ///< the scene's element size after refinement [m]
+  double element_size = 0.0;          ///< the element size on cut_plane after refinement [m]: the scene's, or its
+                                      ///< geometry's `cut_element_size` grading when that is finer
   double elements_in_zone = 0.0;      ///< l_cz / h
   double viscosity = 0.0;             ///< η [Pa s/m] of the law's viscous regularisation (0: none)
   std::string warning;                ///< non-empty when l_cz / h < 3 (Turon et al. 2007)
