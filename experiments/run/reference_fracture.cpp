@@ -10,8 +10,11 @@
 namespace kerf {
 
 CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem& problem, ReferenceFracture mode,
-                             int refinements) {
+                             int refinements, double viscous_time) {
   CrackPathInfo info;
+  if (!(viscous_time >= 0.0) || !std::isfinite(viscous_time))
+    throw std::invalid_argument("reference: scene '" + scene.name + "': the cohesive viscous time must be >= 0 s, got " +
+                                std::to_string(viscous_time));
   if (mode == ReferenceFracture::off) return info;
   const bool fractures = scene.phenomena.contains(Phenomenon::cutting) || scene.phenomena.contains(Phenomenon::tearing);
   const bool has_plane = problem.mesh.find_surface_group("cut_plane") != nullptr;
@@ -31,13 +34,22 @@ CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem&
   spec.minus_surface = "cut_plane-";
   spec.law.cohesive_strength = scene.material.cohesive_strength;
   spec.law.fracture_toughness = scene.material.fracture_toughness;
+  // η = σ_c τ / δ_f (Gao & Bower 2004, Eq. 5, with their relaxation time written as τ).
+  spec.law.viscosity = spec.law.cohesive_strength * viscous_time / spec.law.failure_opening();
   problem.cohesive = spec;
+  info.viscosity = spec.law.viscosity;
 
   info.active = true;
   info.interface_triangles = static_cast<std::size_t>(split.plus_faces.rows());
   info.zone_length = reference::cohesive_zone_length(scene.material.youngs_modulus, scene.material.poisson_ratio,
                                                      scene.material.fracture_toughness, scene.material.cohesive_strength);
-  info.element_size = scene.geometry.element_size / std::pow(2.0, refinements);
+  // The element size on the crack path: the scene's, or the finer size its geometry grades the cut
+  // plane to (rect_prism.geo's cut_element_size), halved by each refinement.
+  double crack_path_size = scene.geometry.element_size;
+  if (const auto graded = scene.geometry.parameters.find("cut_element_size");
+      graded != scene.geometry.parameters.end() && graded->second > 0.0)
+    crack_path_size = std::min(crack_path_size, graded->second);
+  info.element_size = crack_path_size / std::pow(2.0, refinements);
   info.elements_in_zone = reference::elements_in_cohesive_zone(info.zone_length, info.element_size);
   if (info.elements_in_zone < reference::minimum_elements_in_cohesive_zone) {
     char buf[512];

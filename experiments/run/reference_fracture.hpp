@@ -30,18 +30,22 @@ struct CrackPathInfo {
   bool active = false;
   std::size_t interface_triangles = 0; ///< crack triangles joined by the cohesive law
   double zone_length = 0.0;           ///< l_cz [m] (reference/cohesive/cohesive_zone.hpp)
-  double element_size = 0.0;          ///< the scene's element size after refinement [m]
+  double element_size = 0.0;          ///< the element size on cut_plane after refinement [m]: the scene's, or its
+                                      ///< geometry's `cut_element_size` grading when that is finer
   double elements_in_zone = 0.0;      ///< l_cz / h
+  double viscosity = 0.0;             ///< η [Pa s/m] of the law's viscous regularisation (0: none)
   std::string warning;                ///< non-empty when l_cz / h < 3 (Turon et al. 2007)
 };
 
 /// If `mode` asks for it (see ReferenceFracture), splits `problem.mesh` along `cut_plane`
 /// (meshes/crack_split.hpp) and adds the cohesive interface with the scene's cohesive_strength and
 /// fracture_toughness. `refinements` (global, each halving h) enters the zone-resolution check.
-/// Throws std::invalid_argument naming the scene when `mode` is `on` and the scene has no
-/// cut_plane, σ_c or J_c.
+/// `viscous_time` τ [s] >= 0 switches on the law's viscous regularisation (Gao & Bower 2004, Eq. 5;
+/// reference/cohesive/cohesive_law.hpp) with η = σ_c τ / δ_f: the viscous traction reaches σ_c
+/// when the opening grows by δ_f in τ. Throws std::invalid_argument naming the scene when `mode` is
+/// `on` and the scene has no cut_plane, σ_c or J_c, or when τ is negative or not finite.
 CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem& problem, ReferenceFracture mode,
-                             int refinements);
+                             int refinements, double viscous_time = 0.0);
 
 /// The energy bookkeeping of a run (issue 4): external work by the tools on the body
 /// (trapezoid rule over the solved samples, W = Σ ½ (F_k + F_{k−1})·(x_k − x_{k−1}) with F the force

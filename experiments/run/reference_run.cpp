@@ -235,7 +235,8 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     throw std::invalid_argument("reference: checkpoint_every must be >= 1, got " + std::to_string(settings.checkpoint_every));
 
   ReferenceProblem rp = reference_problem(scene, mesh);
-  const CrackPathInfo crack = add_crack_path(scene, rp.problem, settings.fracture, settings.refinements);
+  const CrackPathInfo crack = add_crack_path(scene, rp.problem, settings.fracture, settings.refinements,
+                                              settings.cohesive_viscous_time);
   if (!crack.warning.empty()) std::fprintf(stderr, "reference %s: warning: %s\n", scene.name.c_str(), crack.warning.c_str());
   // The crack extent is measured along the blade's cutting direction (c of paper 001 Fig. 3), or
   // downwards from the grasped top for a tear.
@@ -478,6 +479,8 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                                 {"interface_triangles", crack.interface_triangles},
                                                 {"cohesive_zone_length_m", crack.zone_length},
                                                 {"elements_in_zone", crack.elements_in_zone},
+                                                {"viscous_time_s", settings.cohesive_viscous_time},
+                                                {"viscosity_Pa_s_per_m", crack.viscosity},
                                                 {"warning", crack.warning}}
                                : nlohmann::json(nullptr);
   m["samples"] = cp.samples;

@@ -39,6 +39,9 @@ struct ReferenceRunSettings {
   /// Off by default until Reference II is complete (docs/cohesive-fracture.md, "Not yet done"): the
   /// cohesive reference of a cutting scene is opt-in (`--fracture auto|on`).
   ReferenceFracture fracture = ReferenceFracture::off;
+  /// Viscous regularisation of the cohesive law: relaxation time τ [s] >= 0, η = σ_c τ / δ_f
+  /// (add_crack_path); 0 = none. Its dissipation is booked in the manifest's energy.
+  double cohesive_viscous_time = 0.0;
   /// Fault injection for tests (issue 10): passed to the solver as
   /// reference::SolverSettings::residual_fault (a NaN in the chosen Newton iterations' residual).
   std::function<bool(const reference::LoadState& load, int newton_iteration)> residual_fault;

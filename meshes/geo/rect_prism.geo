@@ -2,17 +2,26 @@
 // x along the long axis (x in [0, length]), y across the width (centred), z up (base at z = 0).
 // Physical groups: volume `body`; surfaces `support` (z = 0), `top` (z = depth), `cut_plane`
 // (internal: x = cut_offset if cut_normal = 0, y = cut_offset if cut_normal = 1), `sides`.
+// Optional grading for a cohesive crack path (docs/cohesive-fracture.md): with cut_element_size > 0
+// the elements within cut_element_size of the cut plane and above z = depth - cut_refine_depth have
+// that size, growing linearly to cut_far_size over cut_grading_distance (a gmsh Box field with a
+// transition layer; the caller's element size, Mesh.MeshSizeMax, caps it); 0 (the default) meshes
+// uniformly.
 SetFactory("OpenCASCADE");
 
 DefineConstant[
   length = {0.040, Min 1e-6, Name "Parameters/length"},
   width = {0.020, Min 1e-6, Name "Parameters/width"},
   depth = {0.015, Min 1e-6, Name "Parameters/depth"},
-  cut_normal = {0, Choices{0, 1}, Name "Parameters/cut_normal"}
+  cut_normal = {0, Choices{0, 1}, Name "Parameters/cut_normal"},
+  cut_element_size = {0, Min 0, Name "Parameters/cut_element_size"},
+  cut_far_size = {0.002, Min 1e-9, Name "Parameters/cut_far_size"},
+  cut_grading_distance = {0.004, Min 0, Name "Parameters/cut_grading_distance"}
 ];
 // The cut plane sits mid-length (cut_normal 0) or on the centre line (cut_normal 1) by default.
 DefineConstant[
-  cut_offset = {(cut_normal == 0) ? length / 2 : 0, Name "Parameters/cut_offset"}
+  cut_offset = {(cut_normal == 0) ? length / 2 : 0, Name "Parameters/cut_offset"},
+  cut_refine_depth = {depth, Min 0, Name "Parameters/cut_refine_depth"}
 ];
 
 If (cut_normal != 0 && cut_normal != 1)
@@ -49,6 +58,29 @@ sides() = CombinedBoundary{ Volume{parts()}; };
 sides() = Abs(sides());
 sides() -= support();
 sides() -= top();
+
+If (cut_element_size > 0)
+  Field[1] = Box;
+  Field[1].VIn = cut_element_size;
+  Field[1].VOut = cut_far_size;
+  Field[1].Thickness = cut_grading_distance;
+  If (cut_normal == 0)
+    Field[1].XMin = cut_offset - cut_element_size;
+    Field[1].XMax = cut_offset + cut_element_size;
+    Field[1].YMin = -width / 2 - eps;
+    Field[1].YMax = width / 2 + eps;
+  Else
+    Field[1].XMin = -eps;
+    Field[1].XMax = length + eps;
+    Field[1].YMin = cut_offset - cut_element_size;
+    Field[1].YMax = cut_offset + cut_element_size;
+  EndIf
+  Field[1].ZMin = depth - cut_refine_depth;
+  Field[1].ZMax = depth + eps;
+  Background Field = 1;
+  Mesh.MeshSizeExtendFromBoundary = 0;
+  Mesh.MeshSizeFromPoints = 0;
+EndIf
 
 If (#support() == 0 || #top() == 0 || #cut() == 0 || #sides() == 0)
   Error("rect_prism.geo: a physical group selection came out empty (bounding-box tolerance eps = %g)", eps);

@@ -35,6 +35,13 @@ double cohesive_dissipation(const CohesiveLawParameters& p, double kappa) {
   return loaded - 0.5 * cohesive_envelope(p, kappa) * kappa;
 }
 
+double viscous_weight(const CohesiveLawParameters& p, double kappa) {
+  const double d0 = p.peak_opening(), df = p.failure_opening();
+  if (kappa <= d0) return 1.0;
+  if (kappa >= df) return 0.0;
+  return (df - kappa) / (df - d0); // T(κ)/σ_c on the softening branch
+}
+
 CohesiveResponse cohesive_response(const CohesiveLawParameters& p, const CohesiveState& state, const Eigen::Vector3d& opening,
                                    const Eigen::Vector3d& n, double dt, bool secant_tangent) {
   const double d0 = p.peak_opening(), df = p.failure_opening(), k0 = p.initial_stiffness();
@@ -72,12 +79,15 @@ CohesiveResponse cohesive_response(const CohesiveLawParameters& p, const Cohesiv
     r.traction += k0 * dn * n;
     r.tangent += k0 * nn;
   }
-  // Viscous regularisation (Gao & Bower 2004, Eq. 5).
+  // Viscous regularisation (Gao & Bower 2004, Eq. 5), weighted by the strength left at the start
+  // of the step, w = T(κ_n)/σ_c past the peak (1 before it, 0 once failed), so that a separated
+  // point carries no traction at all: t_v = η w(κ_n) (Δ − Δ_n)/Δt.
   if (p.viscosity > 0.0 && dt > 0.0) {
+    const double weight = viscous_weight(p, state.max_opening);
     const Eigen::Vector3d rate = (opening - state.previous_opening) / dt;
-    r.traction += p.viscosity * rate;
-    r.tangent += (p.viscosity / dt) * Eigen::Matrix3d::Identity();
-    r.viscous_power_density = p.viscosity * rate.squaredNorm();
+    r.traction += p.viscosity * weight * rate;
+    r.tangent += (p.viscosity * weight / dt) * Eigen::Matrix3d::Identity();
+    r.viscous_power_density = p.viscosity * weight * rate.squaredNorm();
   }
 
   r.effective_opening = d;

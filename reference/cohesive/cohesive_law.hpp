@@ -20,9 +20,14 @@
 //                  to the origin and never heals; secant stiffness K(κ) = T(κ)/κ
 //   traction       t = K(κ) (β² δ_s + ⟨δ_n⟩ n)                       (Ortiz–Pandolfi Eq. 19)
 //   contact        + K_0 δ_n n  when δ_n < 0 (penalty against interpenetration, K_0 = σ_c/δ_0)
-//   viscosity      + η (Δ − Δ_prev)/Δt  (Gao & Bower 2004, Modelling Simul. Mater. Sci. Eng. 12,
+//   viscosity      + η w(κ_n) (Δ − Δ_n)/Δt  (Gao & Bower 2004, Modelling Simul. Mater. Sci. Eng. 12,
 //                  453, Eq. 5: a viscous term that stabilises the softening branch; its dissipation
-//                  is reported so it can be kept negligible)
+//                  is reported so it can be kept negligible). Δ_n, κ_n: the last converged step.
+//                  w = 1 up to the peak, T(κ_n)/σ_c on the softening branch, 0 once failed: the
+//                  viscous traction, like the cohesive one, fades with the strength left, so a
+//                  separated point carries nothing (without w a failed interface stays a dashpot
+//                  that holds the two halves together; taking κ at the start of the step keeps
+//                  the tangent η w/Δt exact)
 //
 // ⟨x⟩ = max(x, 0). β weights sliding against opening (Camacho–Ortiz: the ratio of shear to normal
 // strength; β = 1 treats modes I and II alike). The rising branch δ_0 is a penalty: small against
@@ -66,7 +71,7 @@ struct CohesiveResponse {
   bool failed = false;            ///< κ >= δ_f: the interface carries no tension here any more
   double stored_energy = 0.0;     ///< recoverable energy per area ½ K(κ) δ² + contact ½ K_0 ⟨−δ_n⟩² [J/m^2]
   double dissipated_energy = 0.0; ///< φ_d(κ) = ∫₀^κ T dδ − ½ T(κ) κ [J/m^2] (total, not the increment)
-  double viscous_power_density = 0.0; ///< η |Δ − Δ_prev|² / Δt² [W/m^2] (times Δt: viscous dissipation)
+  double viscous_power_density = 0.0; ///< η w |Δ − Δ_prev|² / Δt² [W/m^2] (times Δt: viscous dissipation)
 };
 
 /// Evaluates the law at opening `opening` with unit normal `normal` (pointing from − into +),
@@ -79,6 +84,10 @@ struct CohesiveResponse {
 CohesiveResponse cohesive_response(const CohesiveLawParameters& parameters, const CohesiveState& state,
                                    const Eigen::Vector3d& opening, const Eigen::Vector3d& normal, double dt,
                                    bool secant_tangent = false);
+
+/// The weight w(κ) in [0, 1] of the viscous term at damage opening κ [m]: 1 for κ <= δ_0,
+/// (δ_f − κ)/(δ_f − δ_0) = T(κ)/σ_c on the softening branch, 0 for κ >= δ_f (see the file comment).
+double viscous_weight(const CohesiveLawParameters& parameters, double damage_opening);
 
 /// The envelope T(δ) [Pa] and its dissipated energy φ_d(κ) [J/m^2] (closed forms of the bilinear law).
 double cohesive_envelope(const CohesiveLawParameters& parameters, double effective_opening);

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace kerf::reference {
 namespace {
@@ -128,6 +129,45 @@ TEST(CohesiveLaw, TangentIsTheDerivativeOfTheTraction) {
           (cohesive_response(p, loaded, opening + e, n, dt).traction - cohesive_response(p, loaded, opening - e, n, dt).traction) / (2 * h);
       EXPECT_LT((numeric - r.tangent.col(c)).norm(), 1e-5 * r.tangent.norm()) << "opening " << opening.transpose() << " column " << c;
     }
+  }
+}
+
+// The viscous term: η times the opening rate on an intact point (Gao & Bower 2004, Eq. 5), scaled
+// by the strength left, T(κ)/σ_c, on a softening point, and absent on a failed one; its power
+// density is the traction's power, t_v · (Δ − Δ_n)/Δt.
+TEST(CohesiveLaw, ViscousTractionFadesWithTheStrengthLeft) {
+  CohesiveLawParameters p = potato();
+  p.viscosity = 2e6;
+  const Eigen::Vector3d n(0, 0, 1);
+  const double df = p.failure_opening(), d0 = p.peak_opening(), dt = 0.01;
+  const Eigen::Vector3d step = Eigen::Vector3d(1e-6, -2e-6, 0);
+  auto viscous = [&](double kappa, const Eigen::Vector3d& base) {
+    CohesiveState s;
+    s.max_opening = kappa;
+    s.previous_opening = base;
+    CohesiveLawParameters plain = p;
+    plain.viscosity = 0.0;
+    // The sliding-only step keeps the cohesive part unchanged between the two evaluations.
+    return std::pair{cohesive_response(p, s, base + step, n, dt), cohesive_response(plain, s, base + step, n, dt)};
+  };
+  const Eigen::Vector3d rate = step / dt;
+  {
+    const auto [with, without] = viscous(0.0, Eigen::Vector3d::Zero());
+    EXPECT_LT((with.traction - without.traction - p.viscosity * rate).norm(), 1e-9 * p.viscosity * rate.norm());
+    EXPECT_NEAR(with.viscous_power_density, p.viscosity * rate.squaredNorm(), 1e-9 * p.viscosity * rate.squaredNorm());
+  }
+  {
+    const double kappa = 0.75 * df;
+    const double w = (df - kappa) / (df - d0);
+    EXPECT_NEAR(viscous_weight(p, kappa), cohesive_envelope(p, kappa) / p.cohesive_strength, 1e-12);
+    const auto [with, without] = viscous(kappa, Eigen::Vector3d(0, 0, 0.5 * df));
+    EXPECT_LT((with.traction - without.traction - w * p.viscosity * rate).norm(), 1e-9 * p.viscosity * rate.norm());
+    EXPECT_NEAR(with.viscous_power_density, (with.traction - without.traction).dot(rate), 1e-9 * with.viscous_power_density);
+  }
+  {
+    const auto [with, without] = viscous(1.5 * df, Eigen::Vector3d(0, 0, 2.0 * df));
+    EXPECT_EQ(with.traction.norm(), 0.0);
+    EXPECT_EQ(with.viscous_power_density, 0.0);
   }
 }
 
