@@ -23,7 +23,6 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 
 using namespace kerf;
@@ -56,10 +55,20 @@ TEST(SpringsOnScenes, ClayPullWritesTheEmbeddedMeshSeries) {
   std::stringstream text;
   text << pvd.rdbuf();
   const std::string body = text.str();
-  const std::regex entry("timestep=\"([^\"]+)\"[^>]*file=\"([^\"]+)\"");
+  // Each <DataSet timestep="T" ... file="F"/> element, in file order.
+  const auto attribute = [&body](std::size_t from, std::size_t to, const std::string& name) {
+    const std::size_t at = body.find(name + "=\"", from);
+    if (at == std::string::npos || at >= to) return std::string();
+    const std::size_t begin = at + name.size() + 2;
+    return body.substr(begin, body.find('"', begin) - begin);
+  };
   std::vector<std::pair<double, std::string>> listed;
-  for (auto it = std::sregex_iterator(body.begin(), body.end(), entry); it != std::sregex_iterator(); ++it)
-    listed.emplace_back(std::stod((*it)[1]), (*it)[2]);
+  for (std::size_t at = body.find("<DataSet"); at != std::string::npos; at = body.find("<DataSet", at + 1)) {
+    const std::size_t end = body.find('>', at);
+    const std::string timestep = attribute(at, end, "timestep"), file = attribute(at, end, "file");
+    ASSERT_FALSE(timestep.empty() || file.empty()) << body.substr(at, end - at);
+    listed.emplace_back(std::stod(timestep), file);
+  }
   ASSERT_EQ(static_cast<int>(listed.size()), frames);
   for (std::size_t k = 1; k < listed.size(); ++k) EXPECT_GT(listed[k].first, listed[k - 1].first);
   const double dt = 1.0 / trajectories.front().rate;
