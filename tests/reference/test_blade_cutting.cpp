@@ -31,28 +31,50 @@
 namespace kerf {
 namespace {
 
-TEST(BladeCutting, SteadyCuttingForceIsToughnessTimesContactLength) {
-  namespace fs = std::filesystem;
-  Scene scene = read_scene(fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / "potato_rect_cut.toml");
-  ASSERT_EQ(scene.tools.size(), 1u);
-  scene.material.cohesive_strength = 1e6;     // δ_f = 2 J_c/σ_c = 0.4 mm
-  scene.tools.front().blade.thickness = 0.5e-3; // > δ_f
-  const TetMesh mesh = scene_mesh(scene);
+/// The scene `name` with the thin blade of this file's route: σ_c = 1 MPa (δ_f = 2 J_c/σ_c =
+/// 0.4 mm) and a blade 0.5 mm thick (> δ_f).
+Scene thin_blade_scene(const std::string& name) {
+  Scene scene = read_scene(std::filesystem::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / (name + ".toml"));
+  scene.material.cohesive_strength = 1e6;
+  if (!scene.tools.empty()) scene.tools.front().blade.thickness = 0.5e-3;
+  return scene;
+}
 
-  // Samples every 0.25 mm of blade travel (1 mm/s, 1 kHz samples): the approach (1 mm) and the
-  // whole 10 mm cut (t = 11 s).
+/// A fracture-on reference run solving every 250th trajectory sample (0.25 mm of blade travel at
+/// 1 mm/s and 1 kHz) up to sample `last`; its profile and the manifest's per-sample ledger.
+struct BladeRun {
+  ForceProfile profile;
+  nlohmann::json manifest;
+  std::size_t samples_asked = 0;
+  std::filesystem::path dir; ///< the run's output folder (removed by the test at its end)
+};
+
+BladeRun run_blade(const Scene& scene, const TetMesh& mesh, std::size_t last, const std::string& dir_name) {
   ReferenceRunSettings settings;
   settings.fracture = ReferenceFracture::on;
   settings.write_fields = false;
   settings.checkpoint_every = 1000;
-  for (std::size_t k = 0; k <= 11000; k += 250) settings.sample_indices.push_back(k);
-  const fs::path dir = fs::temp_directory_path() / "kerf_test_blade_cutting";
-  fs::remove_all(dir);
-  const ForceProfile profile = run_reference(scene, mesh, settings, dir);
-  ASSERT_EQ(profile.rows.size(), settings.sample_indices.size()) << "the load path stopped";
+  for (std::size_t k = 0; k <= last; k += 250) settings.sample_indices.push_back(k);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / dir_name;
+  std::filesystem::remove_all(dir);
+  BladeRun run;
+  run.dir = dir;
+  run.profile = run_reference(scene, mesh, settings, dir);
+  run.samples_asked = settings.sample_indices.size();
+  std::ifstream(dir / "manifest.json") >> run.manifest;
+  return run;
+}
 
-  nlohmann::json manifest;
-  std::ifstream(dir / "manifest.json") >> manifest;
+TEST(BladeCutting, SteadyCuttingForceIsToughnessTimesContactLength) {
+  const Scene scene = thin_blade_scene("potato_rect_cut");
+  ASSERT_EQ(scene.tools.size(), 1u);
+  const TetMesh mesh = scene_mesh(scene);
+
+  // Samples every 0.25 mm of blade travel: the approach (1 mm) and the whole 10 mm cut (t = 11 s).
+  const BladeRun run = run_blade(scene, mesh, 11000, "kerf_test_blade_cutting");
+  const ForceProfile& profile = run.profile;
+  ASSERT_EQ(profile.rows.size(), run.samples_asked) << "the load path stopped";
+  const nlohmann::json& manifest = run.manifest;
   const auto& samples = manifest.at("samples");
   auto at_time = [&](double t) -> const nlohmann::json& {
     for (const auto& s : samples)
@@ -97,7 +119,7 @@ TEST(BladeCutting, SteadyCuttingForceIsToughnessTimesContactLength) {
   EXPECT_NEAR(profile.rows.back().crack_extent, 10e-3 - trailing, 1e-3);
   // Energy balance of the whole run (issue 4: 1%).
   EXPECT_LT(std::abs(manifest.at("energy").at("balance_error").get<double>()), 0.01);
-  fs::remove_all(dir);
+  std::filesystem::remove_all(run.dir);
 }
 
 // potato_wedge_cut (tri_prism.geo: base b = 18 mm, apex d_a = 17 mm above it, h = 2 mm, P1): the
@@ -113,11 +135,8 @@ TEST(BladeCutting, SteadyCuttingForceIsToughnessTimesContactLength) {
 // With 2 mm elements the sampled force saw-tooths as the crack front crosses elements, so the force
 // is compared through the work over 3 mm windows.
 TEST(BladeCutting, WedgeForceGrowsWithTheContactLength) {
-  namespace fs = std::filesystem;
-  Scene scene = read_scene(fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / "potato_wedge_cut.toml");
+  const Scene scene = thin_blade_scene("potato_wedge_cut");
   ASSERT_EQ(scene.tools.size(), 1u);
-  scene.material.cohesive_strength = 1e6;       // δ_f = 0.4 mm
-  scene.tools.front().blade.thickness = 0.5e-3; // > δ_f
   const TetMesh mesh = scene_mesh(scene);
   const double b = scene.geometry.parameters.at("base_width"), apex = scene.geometry.parameters.at("depth");
   const double Jc = scene.material.fracture_toughness;
@@ -125,18 +144,10 @@ TEST(BladeCutting, WedgeForceGrowsWithTheContactLength) {
   const double s_f = delta_f / (2.0 * std::tan(0.5 * scene.tools.front().blade.wedge_angle));
 
   // Every 0.25 mm of blade travel: the 1 mm approach and 12 mm below the apex (t = 13 s).
-  ReferenceRunSettings settings;
-  settings.fracture = ReferenceFracture::on;
-  settings.write_fields = false;
-  settings.checkpoint_every = 1000;
-  for (std::size_t k = 0; k <= 13000; k += 250) settings.sample_indices.push_back(k);
-  const fs::path dir = fs::temp_directory_path() / "kerf_test_wedge_cutting";
-  fs::remove_all(dir);
-  const ForceProfile profile = run_reference(scene, mesh, settings, dir);
-  ASSERT_EQ(profile.rows.size(), settings.sample_indices.size()) << "the load path stopped";
-
-  nlohmann::json manifest;
-  std::ifstream(dir / "manifest.json") >> manifest;
+  const BladeRun run = run_blade(scene, mesh, 13000, "kerf_test_wedge_cutting");
+  const ForceProfile& profile = run.profile;
+  ASSERT_EQ(profile.rows.size(), run.samples_asked) << "the load path stopped";
+  const nlohmann::json& manifest = run.manifest;
   const auto& samples = manifest.at("samples");
   // The sample with the blade edge d below the apex: the edge touches it at t = 1 s, then moves at
   // 1 mm/s (the scene's trajectory).
@@ -173,7 +184,7 @@ TEST(BladeCutting, WedgeForceGrowsWithTheContactLength) {
   EXPECT_NEAR(dissipation_ratio, 1.0, 0.05);
   EXPECT_EQ(profile.rows.back().mode, InteractionMode::cutting);
   EXPECT_LT(std::abs(manifest.at("energy").at("balance_error").get<double>()), 0.02);
-  fs::remove_all(dir);
+  std::filesystem::remove_all(run.dir);
 }
 
 } // namespace
