@@ -21,6 +21,7 @@
 #include <chrono>
 #include <fstream>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <unistd.h>
 
@@ -66,11 +67,15 @@ TEST(ViewedModel, SnapshotIsTheModelStateAfterTheStep) {
 
 /// An adapter whose snapshot takes a lock the render side may hold (what the triple buffer
 /// avoids): the springs adapter's capture under `lock`.
+/// `capturing` is raised just before the lock is taken, so the render side knows the snapshot
+/// has reached it.
 class LockingAdapter final : public ModelAdapter {
 public:
-  LockingAdapter(ModelAdapter& inner, std::mutex& lock) : m_inner(inner), m_lock(lock) {}
+  LockingAdapter(ModelAdapter& inner, std::mutex& lock, std::atomic<bool>& capturing)
+      : m_inner(inner), m_lock(lock), m_capturing(capturing) {}
   void reserve(ModelState& state) const override { m_inner.reserve(state); }
   void capture(ModelState& state) const noexcept override {
+    m_capturing.store(true);
     const std::lock_guard<std::mutex> hold(m_lock);
     m_inner.capture(state);
   }
@@ -80,12 +85,26 @@ public:
 private:
   ModelAdapter& m_inner;
   std::mutex& m_lock;
+  std::atomic<bool>& m_capturing;
 };
+
+/// The scheduler state of thread `tid` of this process ('R' running, 'S' sleeping, ...): the
+/// third field of /proc/self/task/TID/stat (proc(5)); '?' when it cannot be read.
+static char thread_state(pid_t tid) {
+  std::ifstream stat("/proc/self/task/" + std::to_string(tid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return '?';
+  const std::size_t name_end = line.rfind(')'); // the command name may hold spaces
+  return name_end + 2 < line.size() ? line[name_end + 2] : '?';
+}
 
 // The count the live view's test relies on (ViewedModel::blocked_snapshots): a snapshot that
 // only copies into the wait-free triple buffer never waits, while one that needs a lock held
-// elsewhere (here by a "render" thread for 20 ms) waits and is counted — the thread's voluntary
-// context switch, whatever the machine's load.
+// elsewhere (here by a "render" thread) waits and is counted — the thread's voluntary context
+// switch, whatever the machine's load. The render thread lets go only once the stepping thread
+// is asleep on the lock (its /proc state 'S' after it reached the capture), so the wait is
+// certain however long the model's step before the capture takes (under a sanitizer on a loaded
+// machine it took longer than a fixed hold).
 TEST(ViewedModel, ASnapshotThatWaitsIsCounted) {
   ClayPull c;
   std::unique_ptr<ModelAdapter> adapter = make_model_adapter(c.model, c.mesh);
@@ -98,17 +117,29 @@ TEST(ViewedModel, ASnapshotThatWaitsIsCounted) {
     EXPECT_EQ(viewed.blocked_snapshots(), 0u);
   }
   std::mutex lock;
-  LockingAdapter locking(*adapter, lock);
+  std::atomic<bool> capturing{false};
+  LockingAdapter locking(*adapter, lock, capturing);
   ViewedModel viewed(c.model, locking, dt);
   std::atomic<bool> held{false};
+  std::atomic<bool> saw_it_sleep{false};
+  const pid_t stepping_thread = gettid();
   std::thread render([&] {
     const std::lock_guard<std::mutex> hold(lock);
     held.store(true);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (!capturing.load() && std::chrono::steady_clock::now() < give_up) std::this_thread::yield();
+    while (std::chrono::steady_clock::now() < give_up) {
+      if (thread_state(stepping_thread) == 'S') {
+        saw_it_sleep.store(true);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
   });
   while (!held.load()) std::this_thread::yield();
   viewed.step(std::span(&c.trajectory[0].samples[0], 1), dt, forces); // waits for the render thread
   render.join();
+  ASSERT_TRUE(saw_it_sleep.load()) << "the stepping thread never slept on the held lock within 60 s";
   EXPECT_EQ(viewed.frames_published(), 1u);
   EXPECT_EQ(viewed.blocked_snapshots(), 1u);
 }
