@@ -29,13 +29,11 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 build_type=Release
-options=()
 if [ "$job" = asan ]; then # docs/reliability.md: flags, run-time options, the leak suppressions
   build="${KERF_BUILD_DIR:-$here/build-asan}"
   build_type=Asan
-  options=(-DKERF_BENCHMARKS=OFF)
 fi
-cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=$build_type "${options[@]}"
+cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=$build_type
 cmake --build "$build" -j2
 
 case "$job" in
