@@ -4,6 +4,7 @@
 
 #include "experiments/cli/commands.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/blas_threads.hpp"
 #include "experiments/study/study_plots.hpp"
 #include "experiments/study/study_ranks.hpp"
 #include "experiments/study/study_runner.hpp"
@@ -40,6 +41,8 @@ void run_study_command(const StudyOptions& o) {
   const StudySpec spec = read_study(resolve_study(o.study));
   const fs::path out = o.out.empty() ? fs::path("runs") / "studies" / spec.name : fs::path(o.out);
   const StudyRanks ranks;
+  // The study's runs take the cores one each: the BLAS's own threads would only compete with them.
+  limit_blas_to_one_thread();
   const StudyResult result = run_study(spec, out, finite_element_reference(), ranks.execution(o.jobs));
   if (ranks.rank() != 0) return; // rank 0 writes the tables, plots and documents
   const StudyTable table = result.table();
@@ -72,8 +75,10 @@ void run_study_command(const StudyOptions& o) {
   for (const StudyRow& r : result.rows) any_error = any_error || r.metrics.has_value();
   if (any_error) plot_pareto(out / "pareto", out / "study.csv", "RMS force error [%]", "p99 cost [µs]", "model");
 
-  std::printf("study %s: %zu rows, %d reference solve(s) run (the rest from the cache), %d job(s) x %d rank(s)\n%s",
-              spec.name.c_str(), result.rows.size(), result.reference_runs, o.jobs, ranks.size(), table.markdown().c_str());
+  std::printf("study %s: %zu rows, %d reference solve(s) run (the rest from the cache), %d job(s) x %d rank(s); "
+              "wall %.1f s for the reference solves and model runs, %.1f s for the fits\n%s",
+              spec.name.c_str(), result.rows.size(), result.reference_runs, o.jobs, ranks.size(), result.run_seconds,
+              result.fit_seconds, table.markdown().c_str());
   std::printf("wrote %s.{md,tex,csv} and plots in %s\n", (out / "study").c_str(), out.c_str());
 
   if (!o.results_doc.empty()) {
@@ -81,7 +86,9 @@ void run_study_command(const StudyOptions& o) {
                       "` (the README's first command); do not edit by hand.\n\n" + spec.description + "\n\n" +
                       table.markdown() +
                       "\nErrors are against the finest reference level; `reference L<k>` rows are the reference's own "
-                      "discretisation error (a model error below them is not a measured accuracy). Costs are wall "
+                      "discretisation error (a model error below them is not a measured accuracy). Each model is "
+                      "scored over the phases it represents: on all of the reference's samples unless its note says "
+                      "which; a `not run:` note says why a model of the study has no numbers on a scene. Costs are wall "
                       "time per servo step on the machine that ran the study. Plots: `" +
                       (out / "pareto.png").string() + "` and `" + (out / "SCENE_profiles.png").string() + "`.\n";
     write_atomically(o.results_doc, [&](const fs::path& tmp) {

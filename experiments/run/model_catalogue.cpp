@@ -13,7 +13,20 @@ struct CatalogueEntry {
   BuiltModel (*build)(const Scene&, const TetMesh&);
   /// For a model that takes options (then `build` may be null).
   BuiltModel (*build_with_options)(const Scene&, const TetMesh&, const ModelOptions&) = nullptr;
+  /// What it reproduces of a scene when less than the scene's phenomena it covers; null: those.
+  PhenomenonSet (*represents)(const Scene&) = nullptr;
 };
+
+/// The phenomena in both `a` and `b`.
+PhenomenonSet common(PhenomenonSet a, PhenomenonSet b) { return a.missing_from(a.missing_from(b)); }
+
+/// The spring network with a blade: the edge presses the network (deformation), nothing is cut and
+/// nothing slides (springs_builder.cpp); with styluses, what it covers (deformation, tearing).
+PhenomenonSet springs_represent(const Scene& scene) {
+  const bool blade = !scene.tools.empty() && scene.tools.front().kind == Tool::Kind::blade;
+  return common(scene.phenomena, blade ? PhenomenonSet{Phenomenon::deformation}
+                                       : PhenomenonSet{Phenomenon::deformation, Phenomenon::tearing});
+}
 
 const CatalogueEntry catalogue[] = {
     {{"fracture", "energy-based sharp cutting: deformation, rupture, cutting (f = J_c l), layers, pre-sliding friction",
@@ -35,7 +48,7 @@ const CatalogueEntry catalogue[] = {
                  "on a one-blade cutting scene the deformation phase only (the edge presses the network: no cut, no friction)",
       "paper 000 §2.1, §2.2", PhenomenonSet{Phenomenon::deformation, Phenomenon::tearing, Phenomenon::cutting, Phenomenon::friction},
       "one or two spheres (styluses), or one blade (deformation phase)"},
-     &require_springs_inputs, nullptr, &build_springs_model},
+     &require_springs_inputs, nullptr, &build_springs_model, &springs_represent},
 };
 
 const std::vector<ModelDescription> descriptions = [] {
@@ -86,6 +99,12 @@ const ModelDescription& require_model_for_scene(std::string_view name, const Sce
                         scene.name + " declares (it covers " + d.covers.to_string() + ")");
   entry->require_inputs(scene);
   return d;
+}
+
+PhenomenonSet represented_phenomena(std::string_view name, const Scene& scene) {
+  const ModelDescription& d = require_model_for_scene(name, scene);
+  const CatalogueEntry* entry = find_entry(name);
+  return entry->represents ? entry->represents(scene) : common(scene.phenomena, d.covers);
 }
 
 BuiltModel make_model(std::string_view name, const Scene& scene, const TetMesh& mesh, const ModelOptions& options) {

@@ -57,6 +57,13 @@ struct BuiltModel {
 /// missing); returns the model's description.
 const ModelDescription& require_model_for_scene(std::string_view name, const Scene& scene);
 
+/// The phenomena of `scene` that model `name` reproduces on it (after require_model_for_scene):
+/// the scene's phenomena that the model covers, less those it is admitted without on that scene —
+/// the spring network on a one-blade cutting scene presses the blade's edge into the network and
+/// neither cuts nor rubs (the deformation phase only, paper 000 §2.1). A study scores a model only
+/// over the phases of these phenomena (study_runner.hpp). Throws as require_model_for_scene.
+PhenomenonSet represented_phenomena(std::string_view name, const Scene& scene);
+
 /// The regions of a scene's body and the fracture toughness of each: one per layer (volume group
 /// names) for a layered scene, else one unnamed region (the whole mesh) with the material's J_c.
 struct ToughnessRegions {

@@ -6,6 +6,8 @@
 #include "reference/mpi_processes.hpp"
 
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
@@ -15,7 +17,7 @@ ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, in
                                               const std::vector<std::size_t>& sample_indices) {
   ReferenceRunSettings settings;
   settings.degree = spec.degree;
-  settings.refinements = level;
+  settings.refinements = std::max(level, 0);
   settings.sample_indices = sample_indices;
   settings.write_fields = false;
   settings.linear_solver = spec.linear_solver;
@@ -23,6 +25,18 @@ ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, in
   settings.distribute = false; // one process per solve: the study spreads whole solves over its ranks
   return settings;
 }
+
+Scene study_reference_scene(const Scene& scene, int level) {
+  if (level < minimum_study_mesh_level)
+    throw std::invalid_argument("scene " + scene.name + ": mesh level " + std::to_string(level) + " is below " +
+                                std::to_string(minimum_study_mesh_level));
+  Scene s = scene;
+  // h_k = h 2^-k: a level k < 0 is the geometry meshed anew at 2^-k h.
+  if (level < 0) s.geometry.element_size = std::ldexp(scene.geometry.element_size, -level);
+  return s;
+}
+
+double study_reference_element_size(const Scene& scene, int level) { return std::ldexp(scene.geometry.element_size, -level); }
 
 namespace {
 

@@ -21,10 +21,21 @@
 namespace kerf {
 
 /// The settings a study's reference solve at mesh level `level` runs with: `spec`'s degree,
-/// linear solver and fracture mode, the solved `sample_indices`, no field files, and the mesh not
-/// distributed (each solve is one process's run, whatever the study's MPI ranks: study_runner.hpp).
+/// linear solver and fracture mode, the solved `sample_indices`, no field files, the mesh refined
+/// max(level, 0) times (a level below 0 is a coarser mesh instead: study_reference_scene), and the
+/// mesh not distributed (each solve is one process's run, whatever the study's MPI ranks:
+/// study_runner.hpp).
 ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, int level,
                                               const std::vector<std::size_t>& sample_indices);
+
+/// The scene a study's reference solves at mesh level `level`: `scene` itself for a level >= 0
+/// (its mesh refined `level` times: element size h/2^level), and for a level k < 0 the scene meshed
+/// at 2^-k times its element size h (gmsh cannot un-refine a mesh, so a coarser level is a new mesh
+/// of the same geometry, not nested in the finer ones). Throws std::invalid_argument below -3.
+Scene study_reference_scene(const Scene& scene, int level);
+
+/// The element size [m] of `scene`'s mesh at a study's mesh level `level`: h 2^-level.
+double study_reference_element_size(const Scene& scene, int level);
 
 /// A reference solve's identity in the cache.
 struct ReferenceCacheKey {

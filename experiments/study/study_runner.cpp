@@ -17,7 +17,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <set>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -83,6 +85,39 @@ ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b) {
   return out;
 }
 
+ScoredSamples represented_samples(const ForceProfile& reference, PhenomenonSet scene_phenomena, PhenomenonSet represented) {
+  ScoredSamples out{reference, ""};
+  bool separates = false;
+  for (const Phenomenon p : {Phenomenon::cutting, Phenomenon::tearing})
+    separates = separates || (scene_phenomena.contains(p) && !represented.contains(p));
+  if (!separates) return out;
+  // The first time the reference's body is cut or torn (paper 001 Fig. 11: rupture starts the cut,
+  // deformation-2 presses a cut body).
+  double separated = std::numeric_limits<double>::infinity();
+  for (const ProfileRow& r : reference.rows)
+    if (r.mode == InteractionMode::rupture || r.mode == InteractionMode::cutting || r.mode == InteractionMode::deformation_2 ||
+        r.crack_extent > 0.0)
+      separated = std::min(separated, r.t);
+  out.reference.rows.clear();
+  std::set<double> all_times, kept_times;
+  for (const ProfileRow& r : reference.rows) {
+    all_times.insert(r.t);
+    if (r.t < separated - 1e-9) {
+      out.reference.rows.push_back(r);
+      kept_times.insert(r.t);
+    }
+  }
+  char note[256];
+  if (kept_times.empty())
+    std::snprintf(note, sizeof note, "not scored: it represents %s of this scene, and the reference separates from its first sample",
+                  represented.to_string().c_str());
+  else
+    std::snprintf(note, sizeof note, "scored on the %zu of %zu reference samples before the body separates (t ≤ %.3g s): it represents %s of this scene",
+                  kept_times.size(), all_times.size(), *kept_times.rbegin(), represented.to_string().c_str());
+  out.note = note;
+  return out;
+}
+
 namespace {
 
 /// The steady cutting force J_c l (paper 001 Eq. 10) of a homogeneous box cut across its width by
@@ -110,6 +145,8 @@ struct ModelRun {
   std::string label;      ///< the table's model column
   Scene scene_with_parameters;
   std::filesystem::path dir;
+  PhenomenonSet represented;   ///< what the model reproduces of the scene (represented_phenomena)
+  std::string not_applicable;  ///< why the model cannot run on the scene (then it is not run)
 };
 
 /// One reference solve: a scene (possibly with another trajectory than its file's) at a mesh level
@@ -242,8 +279,8 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
   std::vector<FitRun> fit_runs;
   const bool with_reference = spec.has_reference && reference;
   const auto plan_solve = [&](const Scene& scene, int level, int samples) {
-    ReferenceSolve solve{scene, level, solved_samples(scene, samples), {}, {}};
-    const ReferenceCacheKey key = reference_cache_key(scene, study_reference_settings(spec.reference, level, solve.indices));
+    ReferenceSolve solve{study_reference_scene(scene, level), level, solved_samples(scene, samples), {}, {}};
+    const ReferenceCacheKey key = reference_cache_key(solve.scene, study_reference_settings(spec.reference, level, solve.indices));
     solve.dir = out / "cache" / key.directory;
     solve.key_text = key.text;
     solves.push_back(std::move(solve));
@@ -256,19 +293,22 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       for (int level : spec.reference.refinements) planned.levels.push_back(plan_solve(scene, level, spec.reference.samples));
     const std::size_t index = scenes.size();
     for (const std::string& model : spec.models) {
+      PhenomenonSet represented;
       try {
-        require_model_for_scene(model, scene);
-      } catch (const std::exception&) {
-        continue; // not applicable: not in the table
+        represented = represented_phenomena(model, scene);
+      } catch (const ModelMismatch& e) {
+        // Not applicable: a row without numbers whose note says why.
+        model_runs.push_back({index, model, model, scene, out / scene.name / model, {}, std::string("not run: ") + e.what()});
+        continue;
       }
-      model_runs.push_back({index, model, model, scene, out / scene.name / model});
+      model_runs.push_back({index, model, model, scene, out / scene.name / model, represented, ""});
       const auto calibrated = spec.calibrations.find(scene_file.stem().string());
       if (calibrated != spec.calibrations.end())
         for (const fs::path& parameters : calibrated->second) {
           const auto models = calibrated_models(parameters);
           if (std::find(models.begin(), models.end(), model) == models.end()) continue;
           model_runs.push_back({index, model, model + " (calibrated)", read_scene(scene_file, {parameters}),
-                                out / scene.name / (model + "-calibrated")});
+                                out / scene.name / (model + "-calibrated"), represented, ""});
         }
       for (const StudyCalibrationFit& fit : spec.fits) {
         if (!with_reference || fit.scene != scene_file.stem().string() || fit.model != model) continue;
@@ -300,7 +340,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     if (mine(k)) my_references.push_back(reference_runs[k]);
   std::vector<const ModelRun*> my_models;
   for (std::size_t k = 0; k < model_runs.size(); ++k)
-    if (mine(reference_runs.size() + k)) my_models.push_back(&model_runs[k]);
+    if (mine(reference_runs.size() + k) && model_runs[k].not_applicable.empty()) my_models.push_back(&model_runs[k]);
   std::vector<const FitRun*> my_fits;
   for (std::size_t k = 0; k < fit_runs.size(); ++k)
     if (mine(reference_runs.size() + model_runs.size() + k)) my_fits.push_back(&fit_runs[k]);
@@ -340,10 +380,15 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
         write_text(run->dir / "note.txt", e.what());
       }
     });
+  const auto started = std::chrono::steady_clock::now();
+  const auto seconds_since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
   run_tasks(tasks, execution.jobs);
 
   StudyResult result;
   result.reference_runs = synchronise(solved); // every reference is on disk: the fits may read theirs
+  result.run_seconds = seconds_since(started);
 
   // Phase 2: the fitted calibrations, each against its reference on the calibration trajectory,
   // then scored on the scene's own trajectory.
@@ -388,8 +433,10 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
         write_text(run->dir / "note.txt", e.what());
       }
     });
+  const auto fits_started = std::chrono::steady_clock::now();
   run_tasks(tasks, execution.jobs);
   synchronise(0);
+  result.fit_seconds = seconds_since(fits_started);
   if (execution.rank != 0) return result;
 
   // Rank 0: the table, from what every rank wrote.
@@ -409,25 +456,35 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     // The reference's own discretisation error: each coarser level against the finest.
     for (const auto& [level, profile] : references) {
       if (&profile == finest) continue;
-      StudyRow row{scene.name, "reference L" + std::to_string(level), std::nullopt, cost_statistics(profile), ""};
+      char note[160];
+      std::snprintf(note, sizeof note, "mesh h = %.3g mm against the finest, L%d with h = %.3g mm", study_reference_element_size(scene, level) * 1e3,
+                    references.rbegin()->first, study_reference_element_size(scene, references.rbegin()->first) * 1e3);
+      StudyRow row{scene.name, "reference L" + std::to_string(level), std::nullopt, cost_statistics(profile), note};
       try {
         row.metrics = compare_profiles(at_common_times(profile, *finest), at_common_times(*finest, profile), tool);
       } catch (const std::exception& e) {
-        row.note = e.what();
+        row.note += std::string("; ") + e.what();
       }
       result.rows.push_back(std::move(row));
     }
 
-    // The model rows, each fitted calibration right after its model's plain row.
-    std::vector<std::tuple<std::string, fs::path, bool>> rows; // label, dir, fitted
+    // The model rows, each fitted calibration right after its model's plain row; a model that
+    // cannot run on the scene has its row too, saying why.
+    std::vector<std::tuple<std::string, fs::path, bool, const ModelRun*>> rows; // label, dir, fitted, run
     for (const ModelRun& run : model_runs) {
       if (run.scene != s) continue;
-      rows.emplace_back(run.label, run.dir, false);
+      rows.emplace_back(run.label, run.dir, false, &run);
       for (const FitRun& fit : fit_runs)
-        if (fit.scene == s && fit.fit.model == run.model && run.label == run.model) rows.emplace_back(fit.label, fit.dir, true);
+        if (fit.scene == s && fit.fit.model == run.model && run.label == run.model) rows.emplace_back(fit.label, fit.dir, true, &run);
     }
-    for (const auto& [label, dir, fitted] : rows) {
+    const auto join = [](const std::string& a, const std::string& b) { return a.empty() ? b : b.empty() ? a : a + "; " + b; };
+    for (const auto& [label, dir, fitted, run] : rows) {
       StudyRow row{scene.name, label, std::nullopt, {}, ""};
+      if (!run->not_applicable.empty()) {
+        row.note = run->not_applicable;
+        result.rows.push_back(std::move(row));
+        continue;
+      }
       if (!fs::exists(dir / "profile.csv")) {
         row.note = fs::exists(dir / "note.txt") ? read_text(dir / "note.txt") : "no profile written";
         result.rows.push_back(std::move(row));
@@ -437,11 +494,16 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       try {
         const ForceProfile profile = read_profile_csv(dir / "profile.csv");
         row.cost = cost_statistics(profile);
-        if (finest)
-          row.metrics = compare_profiles(at_common_times(profile, *finest), at_common_times(*finest, profile), tool,
-                                         expected_cutting(scene));
+        if (finest) {
+          // Scored only over the phases the model represents (springs on a blade: before the cut).
+          const ScoredSamples scored = represented_samples(*finest, scene.phenomena, run->represented);
+          row.note = join(row.note, scored.note);
+          if (!scored.reference.rows.empty())
+            row.metrics = compare_profiles(at_common_times(profile, scored.reference), at_common_times(scored.reference, profile),
+                                           tool, expected_cutting(scene));
+        }
       } catch (const std::exception& e) {
-        row.note = e.what();
+        row.note = join(row.note, e.what());
       }
       result.rows.push_back(std::move(row));
     }

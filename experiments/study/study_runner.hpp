@@ -42,6 +42,8 @@ struct StudyResult {
   std::vector<StudyRow> rows;
   StudyTable table() const;   ///< the publishable table
   int reference_runs = 0;     ///< reference solves actually run (0 on a fully cached re-run)
+  double run_seconds = 0.0;   ///< wall time of the reference solves and model runs (until every rank has them) [s]
+  double fit_seconds = 0.0;   ///< wall time of the fitted calibrations ([[calibrate]]) [s]
 };
 
 /// How the independent runs of a study are spread: over `jobs` threads of this process and over
@@ -80,6 +82,21 @@ std::vector<std::size_t> reference_sample_indices(std::size_t n, int count);
 
 /// The rows of `profile` whose sample index (row order per tool) is in `indices`.
 ForceProfile subsample(const ForceProfile& profile, const std::vector<std::size_t>& indices);
+
+/// The reference samples a model is scored on: those of the phases it represents.
+struct ScoredSamples {
+  ForceProfile reference; ///< the rows of the reference the model is compared with
+  std::string note;       ///< empty when every sample is scored; else which ones were, and why
+};
+
+/// The phases of `reference` a model represents, given the scene's phenomena and those the model
+/// reproduces on it (represented_phenomena, experiments/run/model_catalogue.hpp). A model that
+/// represents every way the scene's body comes apart (cutting, tearing) — or a scene that declares
+/// none — is scored on every sample. Otherwise it is scored on the phase before the body separates:
+/// the samples before the reference's first sample in `rupture`, `cutting` or `deformation-2` mode
+/// or with a crack (paper 001 Fig. 11: no-contact and deformation-1; after that the reference's body
+/// is cut, one the model does not have) — all rows at those times, every tool.
+ScoredSamples represented_samples(const ForceProfile& reference, PhenomenonSet scene_phenomena, PhenomenonSet represented);
 
 /// The calibration trajectory of a fitted calibration ([[calibrate]], study_spec.hpp): `scene`
 /// with its scripted trajectory played `speed` times as fast — every move at `speed` times its

@@ -88,11 +88,16 @@ StudySpec read_study(const std::filesystem::path& file) {
     }
     if (auto r = (*ref)["refinements"]) {
       const toml::array* a = r.as_array();
-      if (!a || a->empty()) fail(file, r.node()->source(), "reference.refinements", "expected an array of levels >= 0");
+      const std::string range = std::to_string(minimum_study_mesh_level) + "..4";
+      if (!a || a->empty()) fail(file, r.node()->source(), "reference.refinements", "expected an array of levels in " + range);
       spec.reference.refinements.clear();
       for (const toml::node& n : *a) {
         const auto v = n.value<int64_t>();
-        if (!v || *v < 0 || *v > 4) fail(file, n.source(), "reference.refinements", "expected a level in 0..4");
+        if (!v || *v < minimum_study_mesh_level || *v > 4)
+          fail(file, n.source(), "reference.refinements",
+               "expected a level in " + range + " (k < 0: the scene's element size times 2^-k)");
+        if (!spec.reference.refinements.empty() && *v <= spec.reference.refinements.back())
+          fail(file, n.source(), "reference.refinements", "expected ascending levels (the last is the finest)");
         spec.reference.refinements.push_back(static_cast<int>(*v));
       }
     }

@@ -9,7 +9,9 @@
 //
 //   [reference]                                    # optional: the finite-element ground truth
 //   degree = 1
-//   refinements = [0, 1]                           # mesh levels; the last is the finest
+//   refinements = [0, 1]                           # mesh levels, ascending; the last is the finest;
+//                                                  # k >= 0: the scene's mesh refined k times,
+//                                                  # k < 0: meshed at 2^-k times its element size
 //   samples = 40                                   # trajectory samples the reference solves
 //   linear_solver = "auto"                         # "auto", "direct" or "iterative"
 //   fracture = "off"                               # cohesive fracture: "off", "auto" or "on"
@@ -44,11 +46,17 @@
 
 namespace kerf {
 
+/// The coarsest mesh level a study takes: the scene's element size ×8.
+inline constexpr int minimum_study_mesh_level = -3;
+
 /// The finite-element reference of a study ([reference]): its discretisation and solver settings.
 /// Every one of them is in the reference cache's key (reference_cache.hpp).
 struct StudyReferenceSpec {
   int degree = 1;                   ///< FE_SimplexP degree, 1 or 2
-  std::vector<int> refinements{0};  ///< global mesh refinement levels, ascending; the last is the finest
+  /// Mesh levels, ascending; the last is the finest. Level k >= 0: the scene's mesh refined k
+  /// times (element size h/2^k); k < 0: the scene meshed anew at 2^-k h (reference_cache.hpp,
+  /// study_reference_scene), a cheap coarse level. In minimum_study_mesh_level..4.
+  std::vector<int> refinements{0};
   int samples = 40; ///< equilibrium solves along each trajectory (evenly spaced samples)
   /// Linear solver of each Newton step (reference/finite_strain_solver.hpp): "auto" (direct below
   /// 60 000 DOFs), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).

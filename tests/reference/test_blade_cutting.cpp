@@ -11,9 +11,9 @@
 // The route (docs/cohesive-fracture.md, "Steady cutting"): the bilinear law separates the faces only
 // past δ_f = 2 J_c/σ_c, and a blade of thickness t pushes the two halves apart by t behind its
 // edge, which stores elastic energy that grows as t² (the deformation term ΔU of Eq. 6). So the
-// test takes σ_c = 1 MPa, the top of the scene's cited range for potato tensile strength
+// potato scenes take σ_c = 1 MPa, the top of their cited range for potato tensile strength
 // (0.3–1 MPa), which gives δ_f = 0.4 mm, and a thin blade just thicker than that, t = 0.5 mm
-// (the scene's 0.1 mm razor never separates the faces of this law). Its wedge (15°) is 1.9 mm
+// (a 0.1 mm razor never separates the faces of this law). Its wedge (15°) is 1.9 mm
 // long; the force is read from 4 mm depth, with the bevel fully inside, to the end of the cut.
 
 #include "experiments/run/reference_run.hpp"
@@ -31,12 +31,13 @@
 namespace kerf {
 namespace {
 
-/// The scene `name` with the thin blade of this file's route: σ_c = 1 MPa (δ_f = 2 J_c/σ_c =
-/// 0.4 mm) and a blade 0.5 mm thick (> δ_f).
+/// The scene `name` as its file gives it, with the thin blade of this file's route: σ_c = 1 MPa
+/// (δ_f = 2 J_c/σ_c = 0.4 mm) and a blade 0.5 mm thick (> δ_f). Throws if the file no longer does.
 Scene thin_blade_scene(const std::string& name) {
   Scene scene = read_scene(std::filesystem::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / (name + ".toml"));
-  scene.material.cohesive_strength = 1e6;
-  if (!scene.tools.empty()) scene.tools.front().blade.thickness = 0.5e-3;
+  if (std::abs(scene.material.cohesive_strength - 1e6) > 1e-6 || scene.tools.empty() ||
+      std::abs(scene.tools.front().blade.thickness - 0.5e-3) > 1e-12)
+    throw std::runtime_error(name + ": the test's route needs the scene's σ_c = 1 MPa and a 0.5 mm blade");
   return scene;
 }
 

@@ -21,7 +21,8 @@ TEST(ReferenceFracture, ZoneCheckUsesTheCrackPathElementSizeAndViscosityFollowsT
   Scene scene = read_scene(fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / "potato_rect_cut.toml");
   scene.geometry.element_size = 5e-3; // a coarse mesh: the check reads numbers, the mesh only has to split
   const TetMesh mesh = scene_mesh(scene);
-  // Rice's zone for the scene's law (reference/cohesive/cohesive_zone.hpp), 2.66 mm for potato.
+  // Rice's zone for the scene's law (reference/cohesive/cohesive_zone.hpp), 0.665 mm for potato
+  // (σ_c = 1 MPa; (9π/32) E/(1−ν²) J_c/σ_c² = 0.8836 × 3.76 MPa × 200 J/m² / (1 MPa)²).
   const double l_cz = reference::cohesive_zone_length(scene.material.youngs_modulus, scene.material.poisson_ratio,
                                                       scene.material.fracture_toughness, scene.material.cohesive_strength);
   {
@@ -30,18 +31,18 @@ TEST(ReferenceFracture, ZoneCheckUsesTheCrackPathElementSizeAndViscosityFollowsT
     ASSERT_TRUE(info.active);
     EXPECT_DOUBLE_EQ(info.element_size, 2.5e-3); // one refinement halves the 5 mm elements
     EXPECT_NEAR(info.elements_in_zone, l_cz / 2.5e-3, 1e-12);
-    EXPECT_FALSE(info.warning.empty()); // 1.06 elements < 3 (Turon et al. 2007)
+    EXPECT_FALSE(info.warning.empty()); // 0.27 elements < 3 (Turon et al. 2007)
     EXPECT_EQ(info.viscosity, 0.0);
     EXPECT_EQ(rp.problem.cohesive->law.viscosity, 0.0);
   }
   {
-    // A cut plane graded to 0.5 mm (rect_prism.geo's cut_element_size): 5.3 elements in the zone.
+    // A cut plane graded to 0.2 mm (rect_prism.geo's cut_element_size): 3.3 elements in the zone.
     Scene graded = scene;
-    graded.geometry.parameters["cut_element_size"] = 0.5e-3;
+    graded.geometry.parameters["cut_element_size"] = 0.2e-3;
     ReferenceProblem rp = reference_problem(graded, mesh);
     const double tau = 0.1;
     const CrackPathInfo info = add_crack_path(graded, rp.problem, ReferenceFracture::on, 0, tau);
-    EXPECT_DOUBLE_EQ(info.element_size, 0.5e-3);
+    EXPECT_DOUBLE_EQ(info.element_size, 0.2e-3);
     EXPECT_TRUE(info.warning.empty()) << info.warning;
     // η = σ_c τ/δ_f with δ_f = 2 J_c/σ_c (Gao & Bower 2004 in the form of add_crack_path).
     const double delta_f = 2.0 * scene.material.fracture_toughness / scene.material.cohesive_strength;

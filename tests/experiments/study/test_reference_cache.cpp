@@ -42,6 +42,30 @@ TEST(ReferenceCache, StudySettingsCarryTheSpecAndNeverDistribute) {
   EXPECT_FALSE(s.write_fields);
 }
 
+TEST(ReferenceCache, ALevelBelowZeroIsTheSceneMeshedCoarserAndMissesTheFinerLevelsEntry) {
+  // Level k: element size h 2^-k (study_spec.hpp). k >= 0 refines the scene's own mesh k times;
+  // k < 0 meshes it anew at 2^-k h: clay_pull's 2.5 mm (its file) becomes 5 mm at level -1.
+  const Scene scene = clay_pull();
+  const double h = scene.geometry.element_size;
+  EXPECT_DOUBLE_EQ(h, 2.5e-3);
+  EXPECT_DOUBLE_EQ(study_reference_scene(scene, -1).geometry.element_size, 5e-3);
+  EXPECT_DOUBLE_EQ(study_reference_scene(scene, -3).geometry.element_size, 20e-3);
+  EXPECT_DOUBLE_EQ(study_reference_scene(scene, 2).geometry.element_size, h); // refined by the solve
+  EXPECT_DOUBLE_EQ(study_reference_element_size(scene, -1), 5e-3);
+  EXPECT_DOUBLE_EQ(study_reference_element_size(scene, 2), 0.625e-3);
+  EXPECT_THROW(study_reference_scene(scene, -4), std::invalid_argument);
+  StudyReferenceSpec spec;
+  spec.samples = 6;
+  EXPECT_EQ(settings_of(scene, spec, -1).refinements, 0);
+  EXPECT_EQ(settings_of(scene, spec, 2).refinements, 2);
+  // The coarse level's entry is not the scene's own mesh's: the element size is in the key.
+  const Scene coarse = study_reference_scene(scene, -1);
+  const ReferenceCacheKey k_coarse = reference_cache_key(coarse, settings_of(coarse, spec, -1));
+  const ReferenceCacheKey k_own = reference_cache_key(scene, settings_of(scene, spec, 0));
+  EXPECT_NE(k_coarse.directory, k_own.directory);
+  EXPECT_NE(k_coarse.text.find("element_size = 0.0050000000000000001"), std::string::npos) << k_coarse.text;
+}
+
 TEST(ReferenceCache, UnchangedInputsGiveTheSameKey) {
   const Scene a = clay_pull(), b = clay_pull(); // read twice: nothing but the inputs may enter
   StudyReferenceSpec spec;

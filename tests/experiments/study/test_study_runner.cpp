@@ -3,6 +3,7 @@
 
 #include "experiments/study/study_runner.hpp"
 
+#include "experiments/run/model_catalogue.hpp"
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
@@ -49,8 +50,10 @@ TEST(StudySpec, ErrorsNameFileLineColumnAndKey) {
       {"[study]\nname = \"t\"\nscenes = [\"no_scene\"]\nmodels = [\"fracture\"]\n", ":3:"},
       {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\ndegree = 3\n",
        ":6:10: reference.degree"},
-      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\nrefinements = [-1]\n",
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\nrefinements = [-4]\n",
        ":6:16: reference.refinements"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\nrefinements = [0, -1]\n",
+       ":6:19: reference.refinements"},
   };
   int k = 0;
   for (const auto& [text, expected] : cases) {
@@ -99,6 +102,72 @@ TEST(StudyRunner, TwoScenesWithoutAReferenceReportCostsOnly) {
   }
   EXPECT_EQ(r.reference_runs, 0);
   EXPECT_EQ(r.table().row_count(), 2u);
+}
+
+TEST(StudySpec, ACoarseLevelBelowTheScenesMesh) {
+  // refinements = [-1, 0]: the scene meshed at twice its element size, then its own mesh (finest).
+  const StudySpec s = read_study(write_study("coarse.toml", "[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\n"
+                                                            "models = [\"fracture\"]\n[reference]\nrefinements = [-1, 0]\n"));
+  EXPECT_EQ(s.reference.refinements, (std::vector<int>{-1, 0}));
+}
+
+TEST(StudyRunner, AModelIsScoredOnlyOverThePhasesItRepresents) {
+  // A reference that cuts (paper 001 Fig. 11's sequence, one sample per mode and two before the
+  // cut): a model without cutting is compared on the samples before the first rupture only.
+  ForceProfile reference;
+  const InteractionMode modes[] = {InteractionMode::no_contact, InteractionMode::deformation_1, InteractionMode::deformation_1,
+                                   InteractionMode::rupture,    InteractionMode::cutting,       InteractionMode::deformation_2};
+  for (int k = 0; k < 6; ++k) {
+    ProfileRow r;
+    r.tool = "blade";
+    r.t = k;
+    r.mode = modes[k];
+    r.crack_extent = k >= 3 ? 1e-3 * (k - 2) : 0.0;
+    reference.rows.push_back(r);
+  }
+  const PhenomenonSet cut_scene{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction};
+  const ScoredSamples deformation_only = represented_samples(reference, cut_scene, PhenomenonSet{Phenomenon::deformation});
+  ASSERT_EQ(deformation_only.reference.rows.size(), 3u);
+  EXPECT_EQ(deformation_only.reference.rows.back().t, 2.0);
+  EXPECT_NE(deformation_only.note.find("3 of 6 reference samples"), std::string::npos) << deformation_only.note;
+  // A cutting model, or a scene that never separates, is scored everywhere, with no note.
+  const ScoredSamples cutting = represented_samples(reference, cut_scene, cut_scene);
+  EXPECT_EQ(cutting.reference.rows.size(), 6u);
+  EXPECT_TRUE(cutting.note.empty());
+  EXPECT_EQ(represented_samples(reference, PhenomenonSet{Phenomenon::deformation}, PhenomenonSet{Phenomenon::deformation})
+                .reference.rows.size(),
+            6u);
+  // A crack without a mode change (a tearing reference) separates the body too.
+  reference.rows[2].crack_extent = 1e-4;
+  EXPECT_EQ(represented_samples(reference, PhenomenonSet{Phenomenon::deformation, Phenomenon::tearing},
+                                PhenomenonSet{Phenomenon::deformation})
+                .reference.rows.size(),
+            2u);
+  // The spring network on a blade scene represents its deformation phase only (model_catalogue.hpp);
+  // the fracture model all of the potato cut; the springs all of clay_pull.
+  const Scene potato = read_scene(fs::path(KERF_SCENES_DIR) / "potato_rect_cut.toml");
+  const Scene clay = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
+  EXPECT_EQ(represented_phenomena("springs", potato), PhenomenonSet{Phenomenon::deformation});
+  EXPECT_EQ(represented_phenomena("fracture", potato), cut_scene);
+  EXPECT_EQ(represented_phenomena("springs", clay), PhenomenonSet{Phenomenon::deformation});
+}
+
+TEST(StudyRunner, AModelThatCannotRunOnASceneHasARowSayingWhy) {
+  // The voxel model needs a sphere (paper 002's cutting stick); potato_rect_cut has a blade.
+  const StudySpec spec = read_study(write_study(
+      "na.toml", "[study]\nname = \"na\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\", \"voxel\"]\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_na_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const StudyResult r = run_study(spec, out, {});
+  ASSERT_EQ(r.rows.size(), 2u);
+  EXPECT_EQ(r.rows[1].model, "voxel");
+  EXPECT_FALSE(r.rows[1].metrics.has_value());
+  EXPECT_EQ(r.rows[1].cost.steps, 0u);
+  EXPECT_EQ(r.rows[1].note.rfind("not run: ", 0), 0u) << r.rows[1].note;
+  EXPECT_NE(r.rows[1].note.find("sphere"), std::string::npos) << r.rows[1].note;
+  EXPECT_FALSE(fs::exists(out / "potato_rect_cut" / "voxel" / "profile.csv"));
+  EXPECT_EQ(r.table().row_count(), 2u);
+  fs::remove_all(out);
 }
 
 TEST(StudyRunner, CommonTimesKeepOnlyTheSamplesBothRunsHave) {
@@ -357,6 +426,51 @@ TEST(StudyRunner, AChangedSolverSettingMissesTheCacheAnUnchangedOneHitsIt) {
     ++entries;
   }
   EXPECT_EQ(entries, 5);
+}
+
+TEST(StudyRunner, ACoarseLevelIsItsOwnSolveOnTheCoarserMesh) {
+  // refinements = [-1, 0]: two solves, the first given the scene at twice its element size (4 mm
+  // for potato_rect_cut's 2 mm), each in its own cache entry. The stand-in reference is the
+  // fracture model on the scene's own mesh plus (h / 2 mm - 1) x 1 N along x: the L-1 profile is
+  // the finest one offset by exactly 1 N at every sample, so its RMS error is 1 N / max|f_L0|.
+  StudySpec spec = read_study(write_study("levels.toml", "[study]\nname = \"levels\"\nscenes = [\"potato_rect_cut\"]\n"
+                                                         "models = [\"fracture\"]\n[reference]\nrefinements = [-1, 0]\nsamples = 8\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_levels_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  std::atomic<int> solves{0};
+  std::vector<double> sizes;
+  double finest_peak = 0.0;
+  const ReferenceRunner truth = fracture_as_reference(solves, 300.0);
+  const ReferenceRunner offset = [&](const Scene& scene, const StudyReferenceSpec& settings, int level,
+                                     const std::vector<std::size_t>& indices, const fs::path& dir) {
+    const double h = scene.geometry.element_size;
+    sizes.push_back(h);
+    Scene own = scene;
+    own.geometry.element_size = 2e-3;
+    ForceProfile p = truth(own, settings, level, indices, dir);
+    for (ProfileRow& r : p.rows) {
+      r.force.x() += h / 2e-3 - 1.0;
+      if (h == 2e-3) finest_peak = std::max(finest_peak, r.force.norm());
+    }
+    return p;
+  };
+  const StudyResult r = run_study(spec, out, offset);
+  EXPECT_EQ(r.reference_runs, 2);
+  ASSERT_EQ(sizes.size(), 2u);
+  EXPECT_DOUBLE_EQ(sizes[0], 4e-3);
+  EXPECT_DOUBLE_EQ(sizes[1], 2e-3);
+  ASSERT_GE(r.rows.size(), 2u);
+  EXPECT_EQ(r.rows[0].model, "reference L-1");
+  ASSERT_TRUE(r.rows[0].metrics.has_value()) << r.rows[0].note;
+  ASSERT_GT(finest_peak, 0.0);
+  EXPECT_NEAR(r.rows[0].metrics->normalised_rms_force_error, 1.0 / finest_peak, 1e-9);
+  EXPECT_NE(r.rows[0].note.find("h = 4 mm"), std::string::npos) << r.rows[0].note;
+  EXPECT_EQ(r.rows[1].model, "fracture");
+  ASSERT_TRUE(r.rows[1].metrics.has_value()) << r.rows[1].note;
+  EXPECT_NEAR(r.rows[1].metrics->normalised_rms_force_error, 0.0, 1e-12); // the finest is the model itself
+  EXPECT_EQ(std::distance(fs::directory_iterator(out / "cache"), fs::directory_iterator{}), 2);
+  EXPECT_EQ(run_study(spec, out, offset).reference_runs, 0); // both cached
+  fs::remove_all(out);
 }
 
 TEST(StudyRunner, AFittedCalibrationIsScoredOnTheHeldOutTrajectory) {
