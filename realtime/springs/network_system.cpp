@@ -306,24 +306,33 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   // The lease for cholmod_super_numeric's temporary: its cholmod_dense header and L->maxcsize
   // entries, with room for alignment.
   m_update_buffer.assign(m_factor->maxcsize + (sizeof(cholmod_dense) + 256) / sizeof(double) + 1, 0.0);
-  // The solve's workspaces: the single-precision factor, the rows below the tallest supernode.
+  // The solve's workspaces: the rows below the tallest supernode, the widest supernode's dots;
+  // single precision: the inverted blocks' panels (four columns each, rows from the panel's
+  // first column down) and one column of a block in double.
   if (!m_factor->is_super) throw std::runtime_error("NetworkSystem: CHOLMOD did not choose a supernodal factor");
-  m_factor_single.assign(m_precision == SolvePrecision::single_precision ? m_factor->xsize : 0, 0.0f);
   const int* pi = static_cast<const int*>(m_factor->pi);
   const int* super = static_cast<const int*>(m_factor->super);
+  const bool single = m_precision == SolvePrecision::single_precision;
   std::size_t tallest = 1, widest = 4;
+  std::ptrdiff_t panels = 0;
+  m_inverse_block_at.assign(single ? m_factor->nsuper + 1 : 0, 0);
   for (std::size_t sn = 0; sn < m_factor->nsuper; ++sn) {
-    tallest = std::max(tallest, static_cast<std::size_t>(pi[sn + 1] - pi[sn]));
-    widest = std::max(widest, static_cast<std::size_t>(super[sn + 1] - super[sn]));
+    const int nsrow = pi[sn + 1] - pi[sn], nscol = super[sn + 1] - super[sn];
+    tallest = std::max(tallest, static_cast<std::size_t>(nsrow));
+    widest = std::max(widest, static_cast<std::size_t>(nscol));
+    if (single) {
+      m_inverse_block_at[sn] = panels;
+      for (int c = 0; c < nscol; c += 4) panels += 4 * static_cast<std::ptrdiff_t>(nsrow - c);
+    }
   }
+  if (single) m_inverse_block_at[m_factor->nsuper] = panels;
+  m_inverse_blocks.assign(static_cast<std::size_t>(panels), 0.0f);
+  m_inverse_column.assign(single ? tallest : 0, 0.0);
   m_below.assign(tallest, 0.0);
   m_dots.assign(widest, 0.0);
   m_inverse_diagonal.assign(static_cast<std::size_t>(n), 0.0);
-  const bool single = m_precision == SolvePrecision::single_precision;
-  m_inverse_diagonal_single.assign(single ? static_cast<std::size_t>(n) : 0, 0.0f);
   m_solution_single.assign(single ? static_cast<std::size_t>(n) : 0, 0.0f);
-  m_below_single.assign(single ? tallest : 0, 0.0f);
-  m_dots_single.assign(single ? widest : 0, 0.0f);
+  m_rows_single.assign(single ? tallest : 0, 0.0f);
   // One factorisation of the mass matrix: CHOLMOD sizes what it keeps in Common now.
   assemble(net, net.rest, 1.0, 0.0);
   if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
@@ -405,6 +414,122 @@ bool NetworkSystem::bind_split_vertices(const SpringNetwork& net) noexcept {
   return true;
 }
 
+namespace {
+
+/// The inverted blocks of a supernodal L (values `lx`, 1 / L_kk in `inverse_diagonal`): for
+/// supernode s with diagonal triangle T (nscol x nscol) and the rows R below it,
+///   W_s = [T⁻¹; −R T⁻¹],
+/// column j being the supernode's forward substitution applied to the unit vector e_j:
+///   u = e_j;  for k = j … nscol−1:  u_k ← u_k / L_kk,  u_i ← u_i − L_ik u_k (i > k, all rows),
+/// computed in double (`column`: room for the tallest supernode) and stored in single
+/// precision in panels of four columns: panel c at blocks + at[s] + Σ_{c' < c} 4 (nsrow − c'),
+/// its column t (= c + t, zero past nscol) rows c … nsrow−1 at offset t (nsrow − c).
+KERF_VECTOR_CLONES
+void invert_supernode_blocks(const cholmod_factor& L, const double* lx, const double* inverse_diagonal, const std::ptrdiff_t* at,
+                             double* column, float* blocks) noexcept {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* px = static_cast<const int*>(L.px);
+  for (std::size_t s = 0; s < L.nsuper; ++s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, nsrow = pi[s + 1] - pi[s];
+    const double* block = lx + px[s];
+    float* panel = blocks + at[s];
+    for (int c = 0; c < nscol; c += 4) {
+      const int length = nsrow - c;
+      for (int t = 0; t < 4; ++t) {
+        const int j = c + t;
+        float* __restrict out = panel + static_cast<std::ptrdiff_t>(t) * length;
+        if (j >= nscol) {
+          std::fill(out, out + length, 0.0f);
+          continue;
+        }
+        double* __restrict u = column;
+        std::fill(u, u + nsrow, 0.0);
+        u[j] = 1.0;
+        for (int k = j; k < nscol; ++k) {
+          // u_k ← u_k / L_kk;  u_i ← u_i − L_ik u_k for the rows below k
+          const double uk = u[k] *= inverse_diagonal[k1 + k];
+          const double* __restrict lk = block + static_cast<std::ptrdiff_t>(k) * nsrow;
+#pragma omp simd
+          for (int i = k + 1; i < nsrow; ++i) u[i] -= lk[i] * uk;
+        }
+        for (int i = 0; i < length; ++i) out[i] = static_cast<float>(u[c + i]);
+      }
+      panel += 4 * static_cast<std::ptrdiff_t>(length);
+    }
+  }
+}
+
+/// L y = b then Lᵀ x = y in place on x (single precision) with the inverted blocks W_s of
+/// `invert_supernode_blocks`: per supernode (columns k1 …, rows ls[psi …]) forward
+///   r = W_s x_s  (four columns per pass over r),  x_s ← r_top,  x_b += r_below,
+/// then backward, supernodes in reverse,
+///   z = [x_s; x_b],  x_s ← W_sᵀ z  (four dot products per pass over z).
+/// `rows` has room for the tallest supernode.
+KERF_VECTOR_CLONES
+void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std::ptrdiff_t* at, float* x, float* rows) noexcept {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* ls = static_cast<const int*>(L.s);
+  const auto nsuper = static_cast<int>(L.nsuper);
+  float* __restrict r = rows;
+  // Forward: L y = b.
+  for (int s = 0; s < nsuper; ++s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], nsrow = pi[s + 1] - psi;
+    const float* panel = blocks + at[s];
+    float* xs = x + k1;
+    std::fill(r, r + nsrow, 0.0f);
+    for (int c = 0; c < nscol; c += 4) {
+      const int length = nsrow - c;
+      const float* __restrict a0 = panel;
+      const float* __restrict a1 = a0 + length;
+      const float* __restrict a2 = a1 + length;
+      const float* __restrict a3 = a2 + length;
+      // past the supernode's last column the panel is zero: its x is not read
+      const float x0 = xs[c], x1 = c + 1 < nscol ? xs[c + 1] : 0.0f, x2 = c + 2 < nscol ? xs[c + 2] : 0.0f,
+                  x3 = c + 3 < nscol ? xs[c + 3] : 0.0f;
+      float* __restrict rc = r + c;
+#pragma omp simd
+      for (int i = 0; i < length; ++i) rc[i] += (a0[i] * x0 + a1[i] * x1) + (a2[i] * x2 + a3[i] * x3);
+      panel += 4 * static_cast<std::ptrdiff_t>(length);
+    }
+    for (int j = 0; j < nscol; ++j) xs[j] = r[j];
+    for (int i = nscol; i < nsrow; ++i) x[ls[psi + i]] += r[i];
+  }
+  // Backward: Lᵀ x = y.
+  for (int s = nsuper - 1; s >= 0; --s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], nsrow = pi[s + 1] - psi;
+    const float* panel = blocks + at[s];
+    float* xs = x + k1;
+    for (int j = 0; j < nscol; ++j) r[j] = xs[j];
+    for (int i = nscol; i < nsrow; ++i) r[i] = x[ls[psi + i]];
+    for (int c = 0; c < nscol; c += 4) {
+      const int length = nsrow - c;
+      const float* __restrict a0 = panel;
+      const float* __restrict a1 = a0 + length;
+      const float* __restrict a2 = a1 + length;
+      const float* __restrict a3 = a2 + length;
+      const float* __restrict rc = r + c;
+      float d0 = 0.0f, d1 = 0.0f, d2 = 0.0f, d3 = 0.0f;
+#pragma omp simd reduction(+ : d0, d1, d2, d3)
+      for (int i = 0; i < length; ++i) {
+        const float ri = rc[i];
+        d0 += a0[i] * ri;
+        d1 += a1[i] * ri;
+        d2 += a2[i] * ri;
+        d3 += a3[i] * ri;
+      }
+      xs[c] = d0;
+      if (c + 1 < nscol) xs[c + 1] = d1;
+      if (c + 2 < nscol) xs[c + 2] = d2;
+      if (c + 3 < nscol) xs[c + 3] = d3;
+      panel += 4 * static_cast<std::ptrdiff_t>(length);
+    }
+  }
+}
+
+} // namespace
+
 bool NetworkSystem::factorize() noexcept {
   if (!m_factor) return m_factorized = dof_count() == 0;
   cholmod_sparse a{};
@@ -430,7 +555,6 @@ bool NetworkSystem::factorize() noexcept {
   m_factorized = m_common->status == CHOLMOD_OK && lease.live == 0;
   if (m_factorized) {
     const double* lx = static_cast<const double*>(m_factor->x);
-    for (std::size_t k = 0; k < m_factor_single.size(); ++k) m_factor_single[k] = static_cast<float>(lx[k]);
     // 1 / L_kk for the solves, from the double-precision diagonal.
     const int* super = static_cast<const int*>(m_factor->super);
     const int* pi = static_cast<const int*>(m_factor->pi);
@@ -440,7 +564,9 @@ bool NetworkSystem::factorize() noexcept {
       for (int j = 0; j < super[sn + 1] - super[sn]; ++j)
         m_inverse_diagonal[static_cast<std::size_t>(super[sn] + j)] = 1.0 / lx[px[sn] + static_cast<std::ptrdiff_t>(j) * (nsrow + 1)];
     }
-    for (std::size_t k = 0; k < m_inverse_diagonal_single.size(); ++k) m_inverse_diagonal_single[k] = static_cast<float>(m_inverse_diagonal[k]);
+    if (m_precision == SolvePrecision::single_precision)
+      invert_supernode_blocks(*m_factor, lx, m_inverse_diagonal.data(), m_inverse_block_at.data(), m_inverse_column.data(),
+                              m_inverse_blocks.data());
   }
   return m_factorized;
 }
@@ -576,27 +702,20 @@ void supernodal_solve_double(const cholmod_factor& L, const double* lx, const do
                              double* dots) noexcept {
   supernodal_solve(L, lx, inverse_diagonal, x, below, dots);
 }
-KERF_VECTOR_CLONES
-void supernodal_solve_single(const cholmod_factor& L, const float* lx, const float* inverse_diagonal, float* x, float* below,
-                             float* dots) noexcept {
-  supernodal_solve(L, lx, inverse_diagonal, x, below, dots);
-}
-
 } // namespace
 
 void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept {
   const int n = dof_count();
   if (n == 0) return;
   // The system is in the factor's order already: no permutation.
-  if (m_factor_single.empty()) {
+  if (m_precision == SolvePrecision::double_precision) {
     std::copy(rhs.data(), rhs.data() + n, out.data());
     supernodal_solve_double(*m_factor, static_cast<const double*>(m_factor->x), m_inverse_diagonal.data(), out.data(), m_below.data(),
                             m_dots.data());
     return;
   }
   for (int k = 0; k < n; ++k) m_solution_single[static_cast<std::size_t>(k)] = static_cast<float>(rhs[k]);
-  supernodal_solve_single(*m_factor, m_factor_single.data(), m_inverse_diagonal_single.data(), m_solution_single.data(),
-                          m_below_single.data(), m_dots_single.data());
+  inverse_block_solve(*m_factor, m_inverse_blocks.data(), m_inverse_block_at.data(), m_solution_single.data(), m_rows_single.data());
   for (int k = 0; k < n; ++k) out[k] = static_cast<double>(m_solution_single[static_cast<std::size_t>(k)]);
 }
 

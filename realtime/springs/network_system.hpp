@@ -27,10 +27,13 @@ public:
   using Matrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
   /// What the triangular solves read and compute in: CHOLMOD's factor itself in double
-  /// precision, or a single-precision copy of it with single-precision arithmetic (half the
-  /// memory traffic and twice the SIMD lanes; for a factor used as the approximate Jacobian of
+  /// precision, or (single precision) the supernodes' inverted blocks W_s = [T_s⁻¹; −R_s T_s⁻¹]
+  /// (T_s a supernode's diagonal triangle of L, R_s the rows below it) computed in double from
+  /// the factor after each factorisation and stored in single precision, applied with
+  /// single-precision arithmetic (half the memory traffic, twice the SIMD lanes, and no
+  /// sequential triangle inside a supernode); for a factor used as the approximate Jacobian of
   /// modified Newton, whose residual is evaluated in double precision: the solve's relative
-  /// error, ~κ(A) 10⁻⁷, only slows its linear convergence by that much).
+  /// error, ~κ(A) 10⁻⁷, only slows its linear convergence by that much.
   enum class SolvePrecision { double_precision, single_precision };
 
   explicit NetworkSystem(SolvePrecision precision = SolvePrecision::double_precision);
@@ -77,14 +80,17 @@ public:
   /// the supernode update block, comes from a buffer this object keeps). False if A is not
   /// positive definite.
   bool factorize() noexcept;
-  /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized):
-  /// L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's supernodal L (dense
-  /// column-major blocks): per supernode the diagonal triangle, then the rows below it as one
-  /// dense product, four columns per pass, in loops the compiler vectorises, with no BLAS call
-  /// and no division (1/L_kk is kept) per supernode (most supernodes of a network are small,
-  /// where the call overhead dominated cholmod_solve2). In double precision, or (SolvePrecision
-  /// single_precision) in single precision on the factor's single-precision copy, rhs and out
-  /// converted once.
+  /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized).
+  /// Double precision: L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's
+  /// supernodal L (dense column-major blocks): per supernode the diagonal triangle, then the
+  /// rows below it as one dense product, four columns per pass, in loops the compiler
+  /// vectorises, with no BLAS call and no division (1/L_kk is kept) per supernode (most
+  /// supernodes of a network are small, where the call overhead dominated cholmod_solve2).
+  /// Single precision (rhs and out converted once), with each supernode's inverted block
+  /// W_s = [T_s⁻¹; −R_s T_s⁻¹] (see SolvePrecision):
+  ///   forward,  [y_s; Δ_b] = W_s y_s, y_b += Δ_b      (y_s = T_s⁻¹ y_s, y_b −= R_s y_s),
+  ///   backward, x_s = W_sᵀ [x_s; x_b]                   (x_s = T_s⁻ᵀ (x_s − R_sᵀ x_b)),
+  /// each one dense matrix-vector product of independent columns (four per pass).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept;
 
   /// The assembled matrix (lower triangle stored).
@@ -114,12 +120,17 @@ private:
   cholmod_common_struct* m_common = nullptr;
   cholmod_factor_struct* m_factor = nullptr;
   SolvePrecision m_precision;
-  std::vector<float> m_factor_single;  ///< single-precision copy of L's values (single_precision)
+  /// single_precision: the supernodes' inverted blocks W_s in panels of four columns (panel c
+  /// holds columns c..c+3, rows c..nsrow−1, column-major, zero-padded past the last column),
+  /// and where each supernode's panels start.
+  std::vector<float> m_inverse_blocks;
+  std::vector<std::ptrdiff_t> m_inverse_block_at;
+  std::vector<double> m_inverse_column; ///< one column of a W_s in double (factorize)
   std::vector<double> m_below;         ///< solve workspace: the rows below one supernode
   std::vector<double> m_dots;          ///< solve workspace: one supernode's column dot products
   std::vector<double> m_inverse_diagonal; ///< 1 / L_kk of the last factorisation
-  /// single_precision: 1 / L_kk, the solution and the workspaces in single precision.
-  std::vector<float> m_inverse_diagonal_single, m_solution_single, m_below_single, m_dots_single;
+  /// single_precision: the solution and one supernode's rows in single precision.
+  std::vector<float> m_solution_single, m_rows_single;
   std::vector<double> m_update_buffer; ///< CHOLMOD's supernode update workspace (see factorize)
   bool m_factorized = false;
   FillOrdering m_ordering = FillOrdering::amd;

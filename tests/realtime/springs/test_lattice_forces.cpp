@@ -184,8 +184,9 @@ TEST(LatticeForces, SinglePrecisionSubstepsFollowTheDoubleOnes) {
 
 TEST(NetworkSystem, SolvesAgainstADenseFactorisation) {
   // A = M/h² + K_T at a displaced state of the pruned block (two corner nodes fixed), solved by
-  // the supernodal solves on CHOLMOD's factor (double) and on its single-precision copy, against
-  // Eigen's dense LLᵀ of the same assembled matrix.
+  // the supernodal solves on CHOLMOD's factor (double) and with the supernodes' inverted blocks
+  // W_s = [T⁻¹; −R T⁻¹] in single precision, against Eigen's dense LLᵀ of the same assembled
+  // matrix.
   Scattered s = scattered_block(5);
   s.net.constraint[0] = fix_all;
   s.net.constraint[static_cast<std::size_t>(s.net.node_count - 1)] = fix_x | fix_z;
@@ -201,7 +202,7 @@ TEST(NetworkSystem, SolvesAgainstADenseFactorisation) {
     for (Eigen::Index k = 0; k < rhs.size(); ++k) rhs[k] = u(rng);
     system.solve(rhs, out);
     const Eigen::VectorXd expected = dense.llt().solve(rhs);
-    // Double: round-off of a well-conditioned solve; single: the float factor's 6e-8 relative
+    // Double: round-off of a well-conditioned solve; single: the float blocks' 6e-8 relative
     // entries amplified by the condition number of A (~1e3 here).
     const double tolerance = precision == NetworkSystem::SolvePrecision::double_precision ? 1e-10 : 1e-4;
     EXPECT_LT((out - expected).norm(), tolerance * expected.norm());
