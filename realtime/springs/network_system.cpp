@@ -17,6 +17,11 @@ namespace kerf {
 
 namespace {
 
+/// Rows of one panel of an inverted block (single-precision solve): the panel's rows rounded up
+/// to a multiple of 16 (one AVX-512 vector of floats; the padding is zero), so that the solve's
+/// loops run in whole vectors.
+constexpr int panel_rows(int rows) { return (rows + 15) & ~15; }
+
 // CHOLMOD's numeric supernodal factorisation takes one temporary per call from SuiteSparse's
 // allocator (the dense update block of L->maxcsize entries, cholmod_super_numeric). To keep
 // `factorize` allocation-free, SuiteSparse's allocator hooks are wrapped once: while a thread
@@ -322,17 +327,19 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
     widest = std::max(widest, static_cast<std::size_t>(nscol));
     if (single) {
       m_inverse_block_at[sn] = panels;
-      for (int c = 0; c < nscol; c += 4) panels += 4 * static_cast<std::ptrdiff_t>(nsrow - c);
+      for (int c = 0; c < nscol; c += 4) panels += 4 * static_cast<std::ptrdiff_t>(panel_rows(nsrow - c));
     }
   }
   if (single) m_inverse_block_at[m_factor->nsuper] = panels;
-  m_inverse_blocks.assign(static_cast<std::size_t>(panels), 0.0f);
+  // 16 more for a 64-byte aligned start (whole panels are multiples of 16 floats).
+  m_inverse_blocks.assign(static_cast<std::size_t>(panels) + (single ? 16 : 0), 0.0f);
+  m_inverse_align = single ? static_cast<int>((64 - reinterpret_cast<std::uintptr_t>(m_inverse_blocks.data()) % 64) % 64 / sizeof(float)) : 0;
   m_inverse_column.assign(single ? tallest : 0, 0.0);
   m_below.assign(tallest, 0.0);
   m_dots.assign(widest, 0.0);
   m_inverse_diagonal.assign(static_cast<std::size_t>(n), 0.0);
   m_solution_single.assign(single ? static_cast<std::size_t>(n) : 0, 0.0f);
-  m_rows_single.assign(single ? tallest : 0, 0.0f);
+  m_rows_single.assign(single ? tallest + 16 : 0, 0.0f);
   // One factorisation of the mass matrix: CHOLMOD sizes what it keeps in Common now.
   assemble(net, net.rest, 1.0, 0.0);
   if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
@@ -422,8 +429,9 @@ namespace {
 /// column j being the supernode's forward substitution applied to the unit vector e_j:
 ///   u = e_j;  for k = j … nscol−1:  u_k ← u_k / L_kk,  u_i ← u_i − L_ik u_k (i > k, all rows),
 /// computed in double (`column`: room for the tallest supernode) and stored in single
-/// precision in panels of four columns: panel c at blocks + at[s] + Σ_{c' < c} 4 (nsrow − c'),
-/// its column t (= c + t, zero past nscol) rows c … nsrow−1 at offset t (nsrow − c).
+/// precision in panels of four columns: panel c at blocks + at[s] + Σ_{c' < c} 4 panel_rows(nsrow − c'),
+/// its column t (= c + t, zero past nscol) rows c … nsrow−1 at offset t panel_rows(nsrow − c),
+/// zero in the padding.
 KERF_VECTOR_CLONES
 void invert_supernode_blocks(const cholmod_factor& L, const double* lx, const double* inverse_diagonal, const std::ptrdiff_t* at,
                              double* column, float* blocks) noexcept {
@@ -435,14 +443,12 @@ void invert_supernode_blocks(const cholmod_factor& L, const double* lx, const do
     const double* block = lx + px[s];
     float* panel = blocks + at[s];
     for (int c = 0; c < nscol; c += 4) {
-      const int length = nsrow - c;
+      const int length = nsrow - c, padded = panel_rows(length);
       for (int t = 0; t < 4; ++t) {
         const int j = c + t;
-        float* __restrict out = panel + static_cast<std::ptrdiff_t>(t) * length;
-        if (j >= nscol) {
-          std::fill(out, out + length, 0.0f);
-          continue;
-        }
+        float* __restrict out = panel + static_cast<std::ptrdiff_t>(t) * padded;
+        std::fill(out, out + padded, 0.0f);
+        if (j >= nscol) continue;
         double* __restrict u = column;
         std::fill(u, u + nsrow, 0.0);
         u[j] = 1.0;
@@ -455,17 +461,19 @@ void invert_supernode_blocks(const cholmod_factor& L, const double* lx, const do
         }
         for (int i = 0; i < length; ++i) out[i] = static_cast<float>(u[c + i]);
       }
-      panel += 4 * static_cast<std::ptrdiff_t>(length);
+      panel += 4 * static_cast<std::ptrdiff_t>(padded);
     }
   }
 }
 
 /// L y = b then Lᵀ x = y in place on x (single precision) with the inverted blocks W_s of
-/// `invert_supernode_blocks`: per supernode (columns k1 …, rows ls[psi …]) forward
+/// `invert_supernode_blocks` (64-byte aligned): per supernode (columns k1 …, rows ls[psi …])
+/// forward
 ///   r = W_s x_s  (four columns per pass over r),  x_s ← r_top,  x_b += r_below,
 /// then backward, supernodes in reverse,
-///   z = [x_s; x_b],  x_s ← W_sᵀ z  (four dot products per pass over z).
-/// `rows` has room for the tallest supernode.
+///   z = [x_s; x_b],  x_s ← W_sᵀ z  (four dot products per pass over z),
+/// every pass in whole 16-float vectors over the zero-padded panels. `rows` has room for the
+/// tallest supernode and 16 more.
 KERF_VECTOR_CLONES
 void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std::ptrdiff_t* at, float* x, float* rows) noexcept {
   const int* super = static_cast<const int*>(L.super);
@@ -478,23 +486,28 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
     const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], nsrow = pi[s + 1] - psi;
     const float* panel = blocks + at[s];
     float* xs = x + k1;
-    std::fill(r, r + nsrow, 0.0f);
+    std::fill(r, r + nsrow + 16, 0.0f);
     for (int c = 0; c < nscol; c += 4) {
-      const int length = nsrow - c;
+      const int padded = panel_rows(nsrow - c);
       const float* __restrict a0 = panel;
-      const float* __restrict a1 = a0 + length;
-      const float* __restrict a2 = a1 + length;
-      const float* __restrict a3 = a2 + length;
+      const float* __restrict a1 = a0 + padded;
+      const float* __restrict a2 = a1 + padded;
+      const float* __restrict a3 = a2 + padded;
       // past the supernode's last column the panel is zero: its x is not read
       const float x0 = xs[c], x1 = c + 1 < nscol ? xs[c + 1] : 0.0f, x2 = c + 2 < nscol ? xs[c + 2] : 0.0f,
                   x3 = c + 3 < nscol ? xs[c + 3] : 0.0f;
       float* __restrict rc = r + c;
+      for (int b = 0; b < padded; b += 16) {
 #pragma omp simd
-      for (int i = 0; i < length; ++i) rc[i] += (a0[i] * x0 + a1[i] * x1) + (a2[i] * x2 + a3[i] * x3);
-      panel += 4 * static_cast<std::ptrdiff_t>(length);
+        for (int i = b; i < b + 16; ++i) rc[i] += (a0[i] * x0 + a1[i] * x1) + (a2[i] * x2 + a3[i] * x3);
+      }
+      panel += 4 * static_cast<std::ptrdiff_t>(padded);
     }
     for (int j = 0; j < nscol; ++j) xs[j] = r[j];
-    for (int i = nscol; i < nsrow; ++i) x[ls[psi + i]] += r[i];
+    const int* __restrict below = ls + psi;
+    // the rows below are distinct: the scatter vectorises
+#pragma omp simd
+    for (int i = nscol; i < nsrow; ++i) x[below[i]] += r[i];
   }
   // Backward: Lᵀ x = y.
   for (int s = nsuper - 1; s >= 0; --s) {
@@ -502,28 +515,37 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
     const float* panel = blocks + at[s];
     float* xs = x + k1;
     for (int j = 0; j < nscol; ++j) r[j] = xs[j];
-    for (int i = nscol; i < nsrow; ++i) r[i] = x[ls[psi + i]];
+    const int* __restrict below = ls + psi;
+#pragma omp simd
+    for (int i = nscol; i < nsrow; ++i) r[i] = x[below[i]];
+    std::fill(r + nsrow, r + nsrow + 16, 0.0f);
     for (int c = 0; c < nscol; c += 4) {
-      const int length = nsrow - c;
+      const int padded = panel_rows(nsrow - c);
       const float* __restrict a0 = panel;
-      const float* __restrict a1 = a0 + length;
-      const float* __restrict a2 = a1 + length;
-      const float* __restrict a3 = a2 + length;
+      const float* __restrict a1 = a0 + padded;
+      const float* __restrict a2 = a1 + padded;
+      const float* __restrict a3 = a2 + padded;
       const float* __restrict rc = r + c;
-      float d0 = 0.0f, d1 = 0.0f, d2 = 0.0f, d3 = 0.0f;
-#pragma omp simd reduction(+ : d0, d1, d2, d3)
-      for (int i = 0; i < length; ++i) {
-        const float ri = rc[i];
-        d0 += a0[i] * ri;
-        d1 += a1[i] * ri;
-        d2 += a2[i] * ri;
-        d3 += a3[i] * ri;
+      // sixteen partial sums per column, added up after the pass
+      float d0[16] = {}, d1[16] = {}, d2[16] = {}, d3[16] = {};
+      for (int b = 0; b < padded; b += 16) {
+#pragma omp simd
+        for (int t = 0; t < 16; ++t) {
+          const float ri = rc[b + t];
+          d0[t] += a0[b + t] * ri;
+          d1[t] += a1[b + t] * ri;
+          d2[t] += a2[b + t] * ri;
+          d3[t] += a3[b + t] * ri;
+        }
       }
-      xs[c] = d0;
-      if (c + 1 < nscol) xs[c + 1] = d1;
-      if (c + 2 < nscol) xs[c + 2] = d2;
-      if (c + 3 < nscol) xs[c + 3] = d3;
-      panel += 4 * static_cast<std::ptrdiff_t>(length);
+      float e0 = 0.0f, e1 = 0.0f, e2 = 0.0f, e3 = 0.0f;
+#pragma omp simd reduction(+ : e0, e1, e2, e3)
+      for (int t = 0; t < 16; ++t) e0 += d0[t], e1 += d1[t], e2 += d2[t], e3 += d3[t];
+      xs[c] = e0;
+      if (c + 1 < nscol) xs[c + 1] = e1;
+      if (c + 2 < nscol) xs[c + 2] = e2;
+      if (c + 3 < nscol) xs[c + 3] = e3;
+      panel += 4 * static_cast<std::ptrdiff_t>(padded);
     }
   }
 }
@@ -566,7 +588,7 @@ bool NetworkSystem::factorize() noexcept {
     }
     if (m_precision == SolvePrecision::single_precision)
       invert_supernode_blocks(*m_factor, lx, m_inverse_diagonal.data(), m_inverse_block_at.data(), m_inverse_column.data(),
-                              m_inverse_blocks.data());
+                              m_inverse_blocks.data() + m_inverse_align);
   }
   return m_factorized;
 }
@@ -715,7 +737,7 @@ void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noex
     return;
   }
   for (int k = 0; k < n; ++k) m_solution_single[static_cast<std::size_t>(k)] = static_cast<float>(rhs[k]);
-  inverse_block_solve(*m_factor, m_inverse_blocks.data(), m_inverse_block_at.data(), m_solution_single.data(), m_rows_single.data());
+  inverse_block_solve(*m_factor, m_inverse_blocks.data() + m_inverse_align, m_inverse_block_at.data(), m_solution_single.data(), m_rows_single.data());
   for (int k = 0; k < n; ++k) out[k] = static_cast<double>(m_solution_single[static_cast<std::size_t>(k)]);
 }
 

@@ -121,9 +121,11 @@ private:
   cholmod_factor_struct* m_factor = nullptr;
   SolvePrecision m_precision;
   /// single_precision: the supernodes' inverted blocks W_s in panels of four columns (panel c
-  /// holds columns c..c+3, rows c..nsrow−1, column-major, zero-padded past the last column),
-  /// and where each supernode's panels start.
+  /// holds columns c..c+3, rows c..nsrow−1, column-major, zero-padded past the last column and
+  /// to whole 16-float vectors), where each supernode's panels start (from the 64-byte aligned
+  /// entry m_inverse_align).
   std::vector<float> m_inverse_blocks;
+  int m_inverse_align = 0;
   std::vector<std::ptrdiff_t> m_inverse_block_at;
   std::vector<double> m_inverse_column; ///< one column of a W_s in double (factorize)
   std::vector<double> m_below;         ///< solve workspace: the rows below one supernode
