@@ -334,7 +334,7 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   // 16 more for a 64-byte aligned start (whole panels are multiples of 16 floats).
   m_inverse_blocks.assign(static_cast<std::size_t>(panels) + (single ? 16 : 0), 0.0f);
   m_inverse_align = single ? static_cast<int>((64 - reinterpret_cast<std::uintptr_t>(m_inverse_blocks.data()) % 64) % 64 / sizeof(float)) : 0;
-  m_inverse_column.assign(single ? tallest : 0, 0.0);
+  m_inverse_column.assign(single ? 4 * tallest : 0, 0.0);
   m_below.assign(tallest, 0.0);
   m_dots.assign(widest, 0.0);
   m_inverse_diagonal.assign(static_cast<std::size_t>(n), 0.0);
@@ -428,7 +428,8 @@ namespace {
 ///   W_s = [T⁻¹; −R T⁻¹],
 /// column j being the supernode's forward substitution applied to the unit vector e_j:
 ///   u = e_j;  for k = j … nscol−1:  u_k ← u_k / L_kk,  u_i ← u_i − L_ik u_k (i > k, all rows),
-/// computed in double (`column`: room for the tallest supernode) and stored in single
+/// computed in double, four columns at a time (`column`: room for four of the tallest
+/// supernode's columns), and stored in single
 /// precision in panels of four columns: panel c at blocks + at[s] + Σ_{c' < c} 4 panel_rows(nsrow − c'),
 /// its column t (= c + t, zero past nscol) rows c … nsrow−1 at offset t panel_rows(nsrow − c),
 /// zero in the padding.
@@ -444,22 +445,36 @@ void invert_supernode_blocks(const cholmod_factor& L, const double* lx, const do
     float* panel = blocks + at[s];
     for (int c = 0; c < nscol; c += 4) {
       const int length = nsrow - c, padded = panel_rows(length);
-      for (int t = 0; t < 4; ++t) {
-        const int j = c + t;
-        float* __restrict out = panel + static_cast<std::ptrdiff_t>(t) * padded;
-        std::fill(out, out + padded, 0.0f);
-        if (j >= nscol) continue;
-        double* __restrict u = column;
-        std::fill(u, u + nsrow, 0.0);
-        u[j] = 1.0;
-        for (int k = j; k < nscol; ++k) {
-          // u_k ← u_k / L_kk;  u_i ← u_i − L_ik u_k for the rows below k
-          const double uk = u[k] *= inverse_diagonal[k1 + k];
-          const double* __restrict lk = block + static_cast<std::ptrdiff_t>(k) * nsrow;
+      // The panel's four columns together (u_t = e_{c+t}; a column past nscol stays zero), so
+      // that each column of L is read once per panel. Rows above c + t of u_t stay zero, so
+      // the updates of k < c + t leave u_t unchanged.
+      double* __restrict u0 = column;
+      double* __restrict u1 = u0 + nsrow;
+      double* __restrict u2 = u1 + nsrow;
+      double* __restrict u3 = u2 + nsrow;
+      std::fill(column, column + 4 * static_cast<std::ptrdiff_t>(nsrow), 0.0);
+      u0[c] = 1.0;
+      if (c + 1 < nscol) u1[c + 1] = 1.0;
+      if (c + 2 < nscol) u2[c + 2] = 1.0;
+      if (c + 3 < nscol) u3[c + 3] = 1.0;
+      for (int k = c; k < nscol; ++k) {
+        // u_k ← u_k / L_kk;  u_i ← u_i − L_ik u_k for the rows below k
+        const double d = inverse_diagonal[k1 + k];
+        const double v0 = u0[k] *= d, v1 = u1[k] *= d, v2 = u2[k] *= d, v3 = u3[k] *= d;
+        const double* __restrict lk = block + static_cast<std::ptrdiff_t>(k) * nsrow;
 #pragma omp simd
-          for (int i = k + 1; i < nsrow; ++i) u[i] -= lk[i] * uk;
+        for (int i = k + 1; i < nsrow; ++i) {
+          u0[i] -= lk[i] * v0;
+          u1[i] -= lk[i] * v1;
+          u2[i] -= lk[i] * v2;
+          u3[i] -= lk[i] * v3;
         }
-        for (int i = 0; i < length; ++i) out[i] = static_cast<float>(u[c + i]);
+      }
+      const double* u[4] = {u0, u1, u2, u3};
+      for (int t = 0; t < 4; ++t) {
+        float* __restrict out = panel + static_cast<std::ptrdiff_t>(t) * padded;
+        for (int i = 0; i < length; ++i) out[i] = static_cast<float>(u[t][c + i]);
+        std::fill(out + length, out + padded, 0.0f);
       }
       panel += 4 * static_cast<std::ptrdiff_t>(padded);
     }

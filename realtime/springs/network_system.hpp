@@ -127,7 +127,7 @@ private:
   std::vector<float> m_inverse_blocks;
   int m_inverse_align = 0;
   std::vector<std::ptrdiff_t> m_inverse_block_at;
-  std::vector<double> m_inverse_column; ///< one column of a W_s in double (factorize)
+  std::vector<double> m_inverse_column; ///< four columns of a W_s in double (factorize)
   std::vector<double> m_below;         ///< solve workspace: the rows below one supernode
   std::vector<double> m_dots;          ///< solve workspace: one supernode's column dot products
   std::vector<double> m_inverse_diagonal; ///< 1 / L_kk of the last factorisation
