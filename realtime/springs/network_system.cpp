@@ -774,7 +774,8 @@ template <class Value, class Real>
 }
 
 /// L y = b then Lᵀ x = y in place on x, on a supernodal L whose values are `lx`, in the
-/// arithmetic of `Real` (double on CHOLMOD's factor; single on its single-precision copy).
+/// arithmetic of `Real` (used in double on CHOLMOD's factor: the quasi-static integrator's solve;
+/// the single-precision solve is inverse_block_solve).
 /// Supernode s has columns [k1, k2) and a dense column-major block of nsrow rows (row indices
 /// ls[psi ..]): the first nscol rows are its diagonal triangle, the rest the rows below it. `inverse_diagonal` holds 1 / L_kk (no division
 /// on the solve's path); `below` has room for the tallest supernode, `dots` for the widest.
