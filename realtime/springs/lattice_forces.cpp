@@ -102,9 +102,12 @@ float direction_springs_single(int begin, int end, int o, float ox, float oy, fl
     const float ux = UX[q] - UX[p], uy = UY[q] - UY[p], uz = UZ[q] - UZ[p];
     const float ex = ox + ux, ey = oy + uy, ez = oz + uz;
     const float l = std::sqrt(ex * ex + ey * ey + ez * ez);
-    const float inv_l = l > tiny ? 1.0f / l : 0.0f;
+    // One division for both quotients: w = 1 / (l (l + L)), 1/l = (l + L) w, 1/(l + L) = l w.
+    const bool apart = l > tiny;
+    const float w = 1.0f / (apart ? l * (l + rest) : 1.0f);
+    const float inv_l = apart ? (l + rest) * w : 0.0f;
     // l − L = (l² − L²)/(l + L),  l² − L² = 2 L_vec·Δu + |Δu|²
-    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) / (l + rest);
+    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) * (l * w);
     const float rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
     // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
     const float scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
@@ -132,8 +135,10 @@ float direction_springs_single_fused(int begin, int end, int o, float ox, float 
     const float ux = UX[q] - UX[p], uy = UY[q] - UY[p], uz = UZ[q] - UZ[p];
     const float ex = ox + ux, ey = oy + uy, ez = oz + uz;
     const float l = std::sqrt(ex * ex + ey * ey + ez * ez);
-    const float inv_l = l > tiny ? 1.0f / l : 0.0f;
-    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) / (l + rest);
+    const bool apart = l > tiny;
+    const float w = 1.0f / (apart ? l * (l + rest) : 1.0f);
+    const float inv_l = apart ? (l + rest) * w : 0.0f;
+    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) * (l * w);
     const float rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
     const float scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
     const float gx = scale * ex, gy = scale * ey, gz = scale * ez;

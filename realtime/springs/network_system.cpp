@@ -17,6 +17,24 @@ namespace kerf {
 
 namespace {
 
+/// Rows of one panel of an inverted block (single-precision solve): the panel's rows rounded up
+/// to a multiple of 16 (one AVX-512 vector of floats; the padding is zero), so that the solve's
+/// loops run in whole vectors.
+constexpr int panel_rows(int rows) { return (rows + 15) & ~15; }
+
+/// Whether a supernode of `columns` columns keeps its whole inverted block [T⁻¹; −R T⁻¹] for the
+/// single-precision solve (one dense product per solve direction) rather than T⁻¹ and R apart
+/// (two): R T⁻¹ costs m nscol²/2 operations per factorisation (m rows below), as much as the
+/// factorisation's own update for the wide separators, so only the narrow supernodes, where
+/// the solve's per-supernode overhead counts most, keep it (docs/spring-network.md §2).
+constexpr bool whole_inverted_block(int columns) { return columns <= 48; }
+
+/// Floats of one panel (four columns from column c) of a supernode's blocks.
+constexpr std::ptrdiff_t panel_floats(int nscol, int nsrow, int c) {
+  return 4 * static_cast<std::ptrdiff_t>(whole_inverted_block(nscol) ? panel_rows(nsrow - c)
+                                                                      : panel_rows(nscol - c) + panel_rows(nsrow - nscol));
+}
+
 // CHOLMOD's numeric supernodal factorisation takes one temporary per call from SuiteSparse's
 // allocator (the dense update block of L->maxcsize entries, cholmod_super_numeric). To keep
 // `factorize` allocation-free, SuiteSparse's allocator hooks are wrapped once: while a thread
@@ -306,24 +324,36 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   // The lease for cholmod_super_numeric's temporary: its cholmod_dense header and L->maxcsize
   // entries, with room for alignment.
   m_update_buffer.assign(m_factor->maxcsize + (sizeof(cholmod_dense) + 256) / sizeof(double) + 1, 0.0);
-  // The solve's workspaces: the single-precision factor, the rows below the tallest supernode.
+  // The solve's workspaces: the rows below the tallest supernode, the widest supernode's dots;
+  // single precision: the inverted blocks' panels (four columns each, rows from the panel's
+  // first column down) and one column of a block in double.
   if (!m_factor->is_super) throw std::runtime_error("NetworkSystem: CHOLMOD did not choose a supernodal factor");
-  m_factor_single.assign(m_precision == SolvePrecision::single_precision ? m_factor->xsize : 0, 0.0f);
   const int* pi = static_cast<const int*>(m_factor->pi);
   const int* super = static_cast<const int*>(m_factor->super);
+  const bool single = m_precision == SolvePrecision::single_precision;
   std::size_t tallest = 1, widest = 4;
+  std::ptrdiff_t panels = 0;
+  m_inverse_block_at.assign(single ? m_factor->nsuper + 1 : 0, 0);
   for (std::size_t sn = 0; sn < m_factor->nsuper; ++sn) {
-    tallest = std::max(tallest, static_cast<std::size_t>(pi[sn + 1] - pi[sn]));
-    widest = std::max(widest, static_cast<std::size_t>(super[sn + 1] - super[sn]));
+    const int nsrow = pi[sn + 1] - pi[sn], nscol = super[sn + 1] - super[sn];
+    tallest = std::max(tallest, static_cast<std::size_t>(nsrow));
+    widest = std::max(widest, static_cast<std::size_t>(nscol));
+    if (single) {
+      m_inverse_block_at[sn] = panels;
+      for (int c = 0; c < nscol; c += 4) panels += panel_floats(nscol, nsrow, c);
+    }
   }
+  if (single) m_inverse_block_at[m_factor->nsuper] = panels;
+  // 16 more for a 64-byte aligned start (whole panels are multiples of 16 floats).
+  m_inverse_blocks.assign(static_cast<std::size_t>(panels) + (single ? 16 : 0), 0.0f);
+  m_inverse_align = single ? static_cast<int>((64 - reinterpret_cast<std::uintptr_t>(m_inverse_blocks.data()) % 64) % 64 / sizeof(float)) : 0;
+  m_inverse_column.assign(single ? 4 * tallest : 0, 0.0);
   m_below.assign(tallest, 0.0);
   m_dots.assign(widest, 0.0);
   m_inverse_diagonal.assign(static_cast<std::size_t>(n), 0.0);
-  const bool single = m_precision == SolvePrecision::single_precision;
-  m_inverse_diagonal_single.assign(single ? static_cast<std::size_t>(n) : 0, 0.0f);
   m_solution_single.assign(single ? static_cast<std::size_t>(n) : 0, 0.0f);
-  m_below_single.assign(single ? tallest : 0, 0.0f);
-  m_dots_single.assign(single ? widest : 0, 0.0f);
+  m_rows_single.assign(single ? widest + tallest + 32 : 0, 0.0f);
+  m_rows_split = static_cast<int>(widest) + 16;
   // One factorisation of the mass matrix: CHOLMOD sizes what it keeps in Common now.
   assemble(net, net.rest, 1.0, 0.0);
   if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
@@ -405,6 +435,244 @@ bool NetworkSystem::bind_split_vertices(const SpringNetwork& net) noexcept {
   return true;
 }
 
+namespace {
+
+/// The supernodes' blocks for the single-precision solve, from a supernodal L (values `lx`,
+/// 1 / L_kk in `inverse_diagonal`): for supernode s with diagonal triangle T (nscol x nscol) and
+/// the rows R below it, T⁻¹ and R. Column j of T⁻¹ is the triangle's forward substitution
+/// applied to the unit vector e_j,
+///   u = e_j;  for k = j … nscol−1:  u_k ← u_k / L_kk,  u_i ← u_i − L_ik u_k (k < i < nscol),
+/// computed in double four columns at a time (`column`: room for four of the tallest
+/// supernode's columns); R is L's own rows. Stored in single precision in panels of four
+/// columns, panel c at blocks + at[s] + Σ_{c' < c} panel_floats(nscol, nsrow, c'): its column t
+/// (= c + t, zero past nscol) at offset t (pt(c) + pb) holds T⁻¹'s rows c … nscol−1, then R's
+/// rows, each part zero-padded (pt(c) = panel_rows(nscol − c), pb = panel_rows(nsrow − nscol)).
+/// A narrow supernode (whole_inverted_block) keeps instead the whole inverted block
+/// W = [T⁻¹; −R T⁻¹], the same substitution carried through all nsrow rows: its column t at
+/// offset t panel_rows(nsrow − c) holds W's rows c … nsrow−1, zero-padded.
+KERF_VECTOR_CLONES
+void invert_supernode_blocks(const cholmod_factor& L, const double* lx, const double* inverse_diagonal, const std::ptrdiff_t* at,
+                             double* column, float* blocks) noexcept {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* px = static_cast<const int*>(L.px);
+  for (std::size_t s = 0; s < L.nsuper; ++s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, nsrow = pi[s + 1] - pi[s], m = nsrow - nscol;
+    const int pb = panel_rows(m);
+    const double* block = lx + px[s];
+    float* panel = blocks + at[s];
+    const bool whole = whole_inverted_block(nscol);
+    // rows of the substitution: all (whole block) or the triangle's
+    const int rows = whole ? nsrow : nscol;
+    for (int c = 0; c < nscol; c += 4) {
+      const int top = nscol - c, pt = panel_rows(top);
+      // The panel's four columns together (u_t = e_{c+t}; a column past nscol stays zero), so
+      // that each column of L is read once per panel. Rows above c + t of u_t stay zero, so
+      // the updates of k < c + t leave u_t unchanged.
+      double* __restrict u0 = column;
+      double* __restrict u1 = u0 + rows;
+      double* __restrict u2 = u1 + rows;
+      double* __restrict u3 = u2 + rows;
+      std::fill(column, column + 4 * static_cast<std::ptrdiff_t>(rows), 0.0);
+      u0[c] = 1.0;
+      if (c + 1 < nscol) u1[c + 1] = 1.0;
+      if (c + 2 < nscol) u2[c + 2] = 1.0;
+      if (c + 3 < nscol) u3[c + 3] = 1.0;
+      for (int k = c; k < nscol; ++k) {
+        // u_k ← u_k / L_kk;  u_i ← u_i − L_ik u_k for the triangle's rows below k
+        const double d = inverse_diagonal[k1 + k];
+        const double v0 = u0[k] *= d, v1 = u1[k] *= d, v2 = u2[k] *= d, v3 = u3[k] *= d;
+        const double* __restrict lk = block + static_cast<std::ptrdiff_t>(k) * nsrow;
+#pragma omp simd
+        for (int i = k + 1; i < rows; ++i) {
+          u0[i] -= lk[i] * v0;
+          u1[i] -= lk[i] * v1;
+          u2[i] -= lk[i] * v2;
+          u3[i] -= lk[i] * v3;
+        }
+      }
+      const double* u[4] = {u0, u1, u2, u3};
+      if (whole) {
+        // [T⁻¹; −R T⁻¹]: the substitution's rows c … nsrow−1, zero-padded
+        const int length = nsrow - c, padded = panel_rows(length);
+        for (int t = 0; t < 4; ++t) {
+          float* __restrict out = panel + static_cast<std::ptrdiff_t>(t) * padded;
+          for (int i = 0; i < length; ++i) out[i] = static_cast<float>(u[t][c + i]);
+          std::fill(out + length, out + padded, 0.0f);
+        }
+        panel += 4 * static_cast<std::ptrdiff_t>(padded);
+        continue;
+      }
+      for (int t = 0; t < 4; ++t) {
+        float* __restrict out = panel + static_cast<std::ptrdiff_t>(t) * (pt + pb);
+        for (int i = 0; i < top; ++i) out[i] = static_cast<float>(u[t][c + i]);
+        std::fill(out + top, out + pt, 0.0f);
+        float* __restrict below = out + pt;
+        if (c + t < nscol) {
+          const double* __restrict r = block + static_cast<std::ptrdiff_t>(c + t) * nsrow + nscol;
+          for (int i = 0; i < m; ++i) below[i] = static_cast<float>(r[i]);
+        } else {
+          std::fill(below, below + m, 0.0f);
+        }
+        std::fill(below + m, below + pb, 0.0f);
+      }
+      panel += 4 * static_cast<std::ptrdiff_t>(pt + pb);
+    }
+  }
+}
+
+/// r[0, n) += a0 x0 + a1 x1 + a2 x2 + a3 x3 over whole 16-float vectors (n a multiple of 16).
+[[gnu::always_inline]] inline void panel_product(const float* __restrict a0, const float* __restrict a1, const float* __restrict a2,
+                                                 const float* __restrict a3, float x0, float x1, float x2, float x3, int n,
+                                                 float* __restrict r) noexcept {
+  for (int b = 0; b < n; b += 16) {
+#pragma omp simd
+    for (int i = b; i < b + 16; ++i) r[i] += (a0[i] * x0 + a1[i] * x1) + (a2[i] * x2 + a3[i] * x3);
+  }
+}
+
+/// d_t = a_t[0, n) · z[0, n) for the four columns t (n a multiple of 16): sixteen partial sums
+/// per column, added up after the pass.
+[[gnu::always_inline]] inline void panel_dots(const float* __restrict a0, const float* __restrict a1, const float* __restrict a2,
+                                              const float* __restrict a3, const float* __restrict z, int n, float* d) noexcept {
+  float d0[16] = {}, d1[16] = {}, d2[16] = {}, d3[16] = {};
+  for (int b = 0; b < n; b += 16) {
+#pragma omp simd
+    for (int t = 0; t < 16; ++t) {
+      const float zi = z[b + t];
+      d0[t] += a0[b + t] * zi;
+      d1[t] += a1[b + t] * zi;
+      d2[t] += a2[b + t] * zi;
+      d3[t] += a3[b + t] * zi;
+    }
+  }
+  float e0 = 0.0f, e1 = 0.0f, e2 = 0.0f, e3 = 0.0f;
+#pragma omp simd reduction(+ : e0, e1, e2, e3)
+  for (int t = 0; t < 16; ++t) e0 += d0[t], e1 += d1[t], e2 += d2[t], e3 += d3[t];
+  d[0] = e0, d[1] = e1, d[2] = e2, d[3] = e3;
+}
+
+/// L y = b then Lᵀ x = y in place on x (single precision) with the blocks of
+/// `invert_supernode_blocks` (64-byte aligned): per supernode (columns k1 …, rows ls[psi …])
+/// forward
+///   y_s ← T⁻¹ y_s,  y_b −= R y_s,
+/// then backward, supernodes in reverse,
+///   x_s ← T⁻ᵀ (x_s − Rᵀ x_b),
+/// each a dense product of independent columns over whole 16-float vectors: four columns per
+/// pass for T⁻¹ y_s and R y_s, four dot products per pass for the transposed ones; a narrow
+/// supernode with its whole inverted block W = [T⁻¹; −R T⁻¹] in one product each way,
+///   r = W y_s, y_s ← r_top, y_b += r_below;   x_s ← Wᵀ [x_s; x_b].
+/// `top` has room for the widest supernode and 16 more, `bottom` for the tallest and 16 more.
+KERF_VECTOR_CLONES
+void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std::ptrdiff_t* at, float* x, float* top,
+                         float* bottom) noexcept {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* ls = static_cast<const int*>(L.s);
+  const auto nsuper = static_cast<int>(L.nsuper);
+  const auto column = [](const float* p, int t, int stride) { return p + static_cast<std::ptrdiff_t>(t) * stride; };
+  // Forward: L y = b.
+  for (int s = 0; s < nsuper; ++s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], m = pi[s + 1] - psi - nscol;
+    const int pb = panel_rows(m);
+    float* xs = x + k1;
+    if (whole_inverted_block(nscol)) {
+      // r = W x_s,  x_s ← r_top,  x_b += r_below  (W's lower part is −R T⁻¹)
+      const int nsrow = nscol + m;
+      float* r = bottom;
+      std::fill(r, r + nsrow + 16, 0.0f);
+      const float* panel = blocks + at[s];
+      for (int c = 0; c < nscol; c += 4) {
+        const int padded = panel_rows(nsrow - c);
+        panel_product(panel, column(panel, 1, padded), column(panel, 2, padded), column(panel, 3, padded), xs[c],
+                      c + 1 < nscol ? xs[c + 1] : 0.0f, c + 2 < nscol ? xs[c + 2] : 0.0f, c + 3 < nscol ? xs[c + 3] : 0.0f, padded,
+                      r + c);
+        panel += 4 * static_cast<std::ptrdiff_t>(padded);
+      }
+      for (int j = 0; j < nscol; ++j) xs[j] = r[j];
+      const int* __restrict below = ls + psi + nscol;
+#pragma omp simd
+      for (int i = 0; i < m; ++i) x[below[i]] += r[nscol + i];
+      continue;
+    }
+    // x_s ← T⁻¹ x_s (past the supernode's last column the panel is zero: its x is not read)
+    std::fill(top, top + nscol + 16, 0.0f);
+    const float* panel = blocks + at[s];
+    for (int c = 0; c < nscol; c += 4) {
+      const int pt = panel_rows(nscol - c), stride = pt + pb;
+      panel_product(panel, column(panel, 1, stride), column(panel, 2, stride), column(panel, 3, stride), xs[c],
+                    c + 1 < nscol ? xs[c + 1] : 0.0f, c + 2 < nscol ? xs[c + 2] : 0.0f, c + 3 < nscol ? xs[c + 3] : 0.0f, pt, top + c);
+      panel += 4 * static_cast<std::ptrdiff_t>(stride);
+    }
+    for (int j = 0; j < nscol; ++j) xs[j] = top[j];
+    if (m == 0) continue;
+    // x_b −= R x_s
+    std::fill(bottom, bottom + pb, 0.0f);
+    panel = blocks + at[s];
+    for (int c = 0; c < nscol; c += 4) {
+      const int pt = panel_rows(nscol - c), stride = pt + pb;
+      panel_product(panel + pt, column(panel, 1, stride) + pt, column(panel, 2, stride) + pt, column(panel, 3, stride) + pt, xs[c],
+                    c + 1 < nscol ? xs[c + 1] : 0.0f, c + 2 < nscol ? xs[c + 2] : 0.0f, c + 3 < nscol ? xs[c + 3] : 0.0f, pb, bottom);
+      panel += 4 * static_cast<std::ptrdiff_t>(stride);
+    }
+    const int* __restrict below = ls + psi + nscol;
+    // the rows below are distinct: the scatter vectorises
+#pragma omp simd
+    for (int i = 0; i < m; ++i) x[below[i]] -= bottom[i];
+  }
+  // Backward: Lᵀ x = y.
+  float d[4];
+  for (int s = nsuper - 1; s >= 0; --s) {
+    const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], m = pi[s + 1] - psi - nscol;
+    const int pb = panel_rows(m);
+    float* xs = x + k1;
+    if (whole_inverted_block(nscol)) {
+      // x_s ← Wᵀ [x_s; x_b]
+      const int nsrow = nscol + m;
+      float* z = bottom;
+      for (int j = 0; j < nscol; ++j) z[j] = xs[j];
+      const int* __restrict below = ls + psi + nscol;
+#pragma omp simd
+      for (int i = 0; i < m; ++i) z[nscol + i] = x[below[i]];
+      std::fill(z + nsrow, z + nsrow + 16, 0.0f);
+      const float* panel = blocks + at[s];
+      for (int c = 0; c < nscol; c += 4) {
+        const int padded = panel_rows(nsrow - c);
+        panel_dots(panel, column(panel, 1, padded), column(panel, 2, padded), column(panel, 3, padded), z + c, padded, d);
+        for (int t = 0; t < 4 && c + t < nscol; ++t) xs[c + t] = d[t];
+        panel += 4 * static_cast<std::ptrdiff_t>(padded);
+      }
+      continue;
+    }
+    // u = x_s − Rᵀ x_b into top
+    for (int j = 0; j < nscol; ++j) top[j] = xs[j];
+    std::fill(top + nscol, top + nscol + 16, 0.0f);
+    const float* panel = blocks + at[s];
+    if (m > 0) {
+      const int* __restrict below = ls + psi + nscol;
+#pragma omp simd
+      for (int i = 0; i < m; ++i) bottom[i] = x[below[i]];
+      std::fill(bottom + m, bottom + pb, 0.0f);
+      for (int c = 0; c < nscol; c += 4) {
+        const int pt = panel_rows(nscol - c), stride = pt + pb;
+        panel_dots(panel + pt, column(panel, 1, stride) + pt, column(panel, 2, stride) + pt, column(panel, 3, stride) + pt, bottom, pb, d);
+        for (int t = 0; t < 4 && c + t < nscol; ++t) top[c + t] -= d[t];
+        panel += 4 * static_cast<std::ptrdiff_t>(stride);
+      }
+    }
+    // x_s ← T⁻ᵀ u
+    panel = blocks + at[s];
+    for (int c = 0; c < nscol; c += 4) {
+      const int pt = panel_rows(nscol - c), stride = pt + pb;
+      panel_dots(panel, column(panel, 1, stride), column(panel, 2, stride), column(panel, 3, stride), top + c, pt, d);
+      for (int t = 0; t < 4 && c + t < nscol; ++t) xs[c + t] = d[t];
+      panel += 4 * static_cast<std::ptrdiff_t>(stride);
+    }
+  }
+}
+
+} // namespace
+
 bool NetworkSystem::factorize() noexcept {
   if (!m_factor) return m_factorized = dof_count() == 0;
   cholmod_sparse a{};
@@ -430,7 +698,6 @@ bool NetworkSystem::factorize() noexcept {
   m_factorized = m_common->status == CHOLMOD_OK && lease.live == 0;
   if (m_factorized) {
     const double* lx = static_cast<const double*>(m_factor->x);
-    for (std::size_t k = 0; k < m_factor_single.size(); ++k) m_factor_single[k] = static_cast<float>(lx[k]);
     // 1 / L_kk for the solves, from the double-precision diagonal.
     const int* super = static_cast<const int*>(m_factor->super);
     const int* pi = static_cast<const int*>(m_factor->pi);
@@ -440,7 +707,9 @@ bool NetworkSystem::factorize() noexcept {
       for (int j = 0; j < super[sn + 1] - super[sn]; ++j)
         m_inverse_diagonal[static_cast<std::size_t>(super[sn] + j)] = 1.0 / lx[px[sn] + static_cast<std::ptrdiff_t>(j) * (nsrow + 1)];
     }
-    for (std::size_t k = 0; k < m_inverse_diagonal_single.size(); ++k) m_inverse_diagonal_single[k] = static_cast<float>(m_inverse_diagonal[k]);
+    if (m_precision == SolvePrecision::single_precision)
+      invert_supernode_blocks(*m_factor, lx, m_inverse_diagonal.data(), m_inverse_block_at.data(), m_inverse_column.data(),
+                              m_inverse_blocks.data() + m_inverse_align);
   }
   return m_factorized;
 }
@@ -505,7 +774,8 @@ template <class Value, class Real>
 }
 
 /// L y = b then Lᵀ x = y in place on x, on a supernodal L whose values are `lx`, in the
-/// arithmetic of `Real` (double on CHOLMOD's factor; single on its single-precision copy).
+/// arithmetic of `Real` (used in double on CHOLMOD's factor: the quasi-static integrator's solve;
+/// the single-precision solve is inverse_block_solve).
 /// Supernode s has columns [k1, k2) and a dense column-major block of nsrow rows (row indices
 /// ls[psi ..]): the first nscol rows are its diagonal triangle, the rest the rows below it. `inverse_diagonal` holds 1 / L_kk (no division
 /// on the solve's path); `below` has room for the tallest supernode, `dots` for the widest.
@@ -576,27 +846,21 @@ void supernodal_solve_double(const cholmod_factor& L, const double* lx, const do
                              double* dots) noexcept {
   supernodal_solve(L, lx, inverse_diagonal, x, below, dots);
 }
-KERF_VECTOR_CLONES
-void supernodal_solve_single(const cholmod_factor& L, const float* lx, const float* inverse_diagonal, float* x, float* below,
-                             float* dots) noexcept {
-  supernodal_solve(L, lx, inverse_diagonal, x, below, dots);
-}
-
 } // namespace
 
 void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept {
   const int n = dof_count();
   if (n == 0) return;
   // The system is in the factor's order already: no permutation.
-  if (m_factor_single.empty()) {
+  if (m_precision == SolvePrecision::double_precision) {
     std::copy(rhs.data(), rhs.data() + n, out.data());
     supernodal_solve_double(*m_factor, static_cast<const double*>(m_factor->x), m_inverse_diagonal.data(), out.data(), m_below.data(),
                             m_dots.data());
     return;
   }
   for (int k = 0; k < n; ++k) m_solution_single[static_cast<std::size_t>(k)] = static_cast<float>(rhs[k]);
-  supernodal_solve_single(*m_factor, m_factor_single.data(), m_inverse_diagonal_single.data(), m_solution_single.data(),
-                          m_below_single.data(), m_dots_single.data());
+  inverse_block_solve(*m_factor, m_inverse_blocks.data() + m_inverse_align, m_inverse_block_at.data(), m_solution_single.data(),
+                      m_rows_single.data(), m_rows_single.data() + m_rows_split);
   for (int k = 0; k < n; ++k) out[k] = static_cast<double>(m_solution_single[static_cast<std::size_t>(k)]);
 }
 

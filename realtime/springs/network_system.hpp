@@ -27,10 +27,13 @@ public:
   using Matrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
   /// What the triangular solves read and compute in: CHOLMOD's factor itself in double
-  /// precision, or a single-precision copy of it with single-precision arithmetic (half the
-  /// memory traffic and twice the SIMD lanes; for a factor used as the approximate Jacobian of
-  /// modified Newton, whose residual is evaluated in double precision: the solve's relative
-  /// error, ~κ(A) 10⁻⁷, only slows its linear convergence by that much).
+  /// precision, or (single precision) per supernode the inverse T_s⁻¹ of its diagonal triangle
+  /// (computed in double from the factor after each factorisation) and the rows R_s below it,
+  /// both stored in single precision and applied with single-precision arithmetic (half the
+  /// memory traffic, twice the SIMD lanes, and no sequential triangle inside a supernode); for
+  /// a factor used as the approximate Jacobian of modified Newton, whose residual is evaluated
+  /// in double precision: the solve's relative error, ~κ(A) 10⁻⁷, only slows its linear
+  /// convergence by that much.
   enum class SolvePrecision { double_precision, single_precision };
 
   explicit NetworkSystem(SolvePrecision precision = SolvePrecision::double_precision);
@@ -77,14 +80,16 @@ public:
   /// the supernode update block, comes from a buffer this object keeps). False if A is not
   /// positive definite.
   bool factorize() noexcept;
-  /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized):
-  /// L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's supernodal L (dense
-  /// column-major blocks): per supernode the diagonal triangle, then the rows below it as one
-  /// dense product, four columns per pass, in loops the compiler vectorises, with no BLAS call
-  /// and no division (1/L_kk is kept) per supernode (most supernodes of a network are small,
-  /// where the call overhead dominated cholmod_solve2). In double precision, or (SolvePrecision
-  /// single_precision) in single precision on the factor's single-precision copy, rhs and out
-  /// converted once.
+  /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized).
+  /// Double precision: L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's
+  /// supernodal L (dense column-major blocks): per supernode the diagonal triangle, then the
+  /// rows below it as one dense product, four columns per pass, in loops the compiler
+  /// vectorises, with no BLAS call and no division (1/L_kk is kept) per supernode (most
+  /// supernodes of a network are small, where the call overhead dominated cholmod_solve2).
+  /// Single precision (rhs and out converted once), with each supernode's T_s⁻¹ and R_s (see
+  /// SolvePrecision):
+  ///   forward,  y_s ← T_s⁻¹ y_s,  y_b −= R_s y_s;   backward,  x_s ← T_s⁻ᵀ (x_s − R_sᵀ x_b),
+  /// each a dense matrix-vector product of independent columns (four per pass).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept;
 
   /// The assembled matrix (lower triangle stored).
@@ -114,12 +119,21 @@ private:
   cholmod_common_struct* m_common = nullptr;
   cholmod_factor_struct* m_factor = nullptr;
   SolvePrecision m_precision;
-  std::vector<float> m_factor_single;  ///< single-precision copy of L's values (single_precision)
+  /// single_precision: each supernode's T_s⁻¹ and R_s in panels of four columns (panel c holds
+  /// columns c..c+3: T_s⁻¹'s rows c..nscol−1, then R_s's rows, column-major, each part
+  /// zero-padded to whole 16-float vectors, zero past the last column), where each
+  /// supernode's panels start (from the 64-byte aligned entry m_inverse_align).
+  std::vector<float> m_inverse_blocks;
+  int m_inverse_align = 0;
+  std::vector<std::ptrdiff_t> m_inverse_block_at;
+  std::vector<double> m_inverse_column; ///< four columns of a W_s in double (factorize)
   std::vector<double> m_below;         ///< solve workspace: the rows below one supernode
   std::vector<double> m_dots;          ///< solve workspace: one supernode's column dot products
   std::vector<double> m_inverse_diagonal; ///< 1 / L_kk of the last factorisation
-  /// single_precision: 1 / L_kk, the solution and the workspaces in single precision.
-  std::vector<float> m_inverse_diagonal_single, m_solution_single, m_below_single, m_dots_single;
+  /// single_precision: the solution and one supernode's rows in single precision (its
+  /// triangle's rows first, the rows below from m_rows_split).
+  std::vector<float> m_solution_single, m_rows_single;
+  int m_rows_split = 0;
   std::vector<double> m_update_buffer; ///< CHOLMOD's supernode update workspace (see factorize)
   bool m_factorized = false;
   FillOrdering m_ordering = FillOrdering::amd;

@@ -173,8 +173,13 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
     return report;
   }
   double previous = INFINITY;
+  int refreshes = 0;
   while (report.iterations < m_max_iterations && norm > tolerance) {
-    if (!fresh && norm > 0.25 * previous) { // the kept factorisation no longer converges fast: refresh it
+    // The kept factorisation no longer converges fast: refresh it (at most `max_refreshes`
+    // times per call: where even a fresh one converges slowly, as through a snap-through of
+    // crushed cells, refreshing at every iteration only multiplies the cost).
+    if (!fresh && norm > 0.25 * previous && refreshes < max_refreshes) {
+      ++refreshes;
       if (!refactor(net, x, dt)) break;
       ++report.factorisations;
       fresh = true;
@@ -197,7 +202,9 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
       // No step length helps: back to the iterate, and refresh the factorisation once if it is stale.
       x.leftCols(n) = m_x_before.leftCols(n);
       norm = residual(net, x, v, dt);
-      if (fresh || !refactor(net, x, dt)) break;
+      if (fresh || refreshes >= max_refreshes) break;
+      ++refreshes;
+      if (!refactor(net, x, dt)) break;
       ++report.factorisations;
       fresh = true;
       previous = INFINITY;

@@ -24,6 +24,12 @@ class NewtonStepper {
 public:
   /// Linearly implicit Euler: the residual after the step is checked on every 8th call.
   static constexpr int linearised_check_interval = 8;
+  /// Backward Euler and quasi-static: refreshes of the kept factorisation within one `advance`
+  /// (besides the one a new dt or a tear needs). Where even a fresh factorisation converges
+  /// slowly (a snap-through of the cells crushed under a blade, whose tangent is indefinite
+  /// while K_T is projected) refreshing at every iteration multiplied a sample's cost up to
+  /// 8 x (potato_rect_cut at 8³: 46 ms CPU, one refresh each: 8.5 ms) without converging.
+  static constexpr int max_refreshes = 1;
 
   enum class Mode {
     /// Backward Euler: M (x − xₙ − h vₙ)/h² = f(x, (x − xₙ)/h), v = (x − xₙ)/h.
@@ -62,9 +68,10 @@ public:
   /// Advances (x, v) by dt [s]. On entry the free axes hold the state at tₙ and the fixed axes
   /// their prescribed end-of-step positions and velocities. The Jacobian A = M/h² + (1 + τ/h) K_T (implicit) or K_T + 10⁻⁸ (‖K‖/‖M‖) M (quasi-static; the
   /// small mass term only regularises floating pieces and leaves the solution unchanged) is
-  /// factorised on the first call, when dt changes, and whenever an iteration reduces the
-  /// residual by less than a factor 4, or when no step length of the line search (1, 1/2, …,
-  /// 1/32 of the Newton step) lowers the residual. Allocation-free.
+  /// factorised on the first call, when dt changes, and (at most `max_refreshes` times per
+  /// call) when an iteration reduces the residual by less than a factor 4, or when no step
+  /// length of the line search (1, 1/2, …, 1/32 of the Newton step) lowers the residual.
+  /// Allocation-free.
   NewtonReport advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
 
   /// The internal forces at the state the last `advance` returned (at its velocities, or at
