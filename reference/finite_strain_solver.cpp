@@ -249,6 +249,7 @@ struct FiniteStrainSolver::Impl {
   std::vector<CohesiveState> cohesive_states; // pair-major, then quadrature point
   std::vector<unsigned> cell_components;      // component of each local DOF of a cell
   double cohesive_viscous_dissipation = 0.0;
+  double cohesive_trapezoid_work = 0.0; // dynamic step only: CohesiveSummary::trapezoid_work
   double committed_time = 0.0;
   bool cohesive_secant = false; // Newton fallback: the secant interface tangent (cohesive_law.hpp)
   bool poison_residual = false; // fault injection: SolverSettings::residual_fault chose this assembly
@@ -1126,6 +1127,14 @@ CohesiveSummary FiniteStrainSolver::Impl::commit_cohesive(const LoadState& load)
       const CohesiveResponse r = cohesive_response(*cohesive_law, state, opening, cohesive_pairs[p].normal, dt);
       const double w = cohesive_pairs[p].weights[q];
       if (dt > 0.0) cohesive_viscous_dissipation += r.viscous_power_density * dt * w;
+      if (dynamics) {
+        // ½ (t_n + t_{n+1})·(Δ_{n+1} − Δ_n) without the viscous part (dt = 0): t_n is the traction at
+        // the last converged opening Δ_n with the damage κ_n reached there.
+        const Eigen::Vector3d& n = cohesive_pairs[p].normal;
+        const CohesiveResponse before = cohesive_response(*cohesive_law, state, state.previous_opening, n, 0.0);
+        const CohesiveResponse after = cohesive_law->viscosity > 0.0 ? cohesive_response(*cohesive_law, state, opening, n, 0.0) : r;
+        cohesive_trapezoid_work += 0.5 * (before.traction + after.traction).dot(opening - state.previous_opening) * w;
+      }
       state.max_opening = r.damage_opening;
       state.previous_opening = opening;
       if (r.failed) summary.failed_area += w;
@@ -1136,6 +1145,7 @@ CohesiveSummary FiniteStrainSolver::Impl::commit_cohesive(const LoadState& load)
     }
   committed_time = load.time;
   summary.viscous_dissipation = cohesive_viscous_dissipation;
+  summary.trapezoid_work = cohesive_trapezoid_work;
   return summary;
 }
 
@@ -1400,6 +1410,7 @@ std::vector<double> FiniteStrainSolver::state() const {
     values.insert(values.end(), m.dynamics->v.begin(), m.dynamics->v.end());
     values.insert(values.end(), m.dynamics->a.begin(), m.dynamics->a.end());
     values.push_back(m.committed_time);
+    values.push_back(m.cohesive_trapezoid_work);
   }
   return values;
 }
@@ -1408,12 +1419,12 @@ void FiniteStrainSolver::set_state(const std::vector<double>& values) {
   Impl& m = *m_impl;
   const std::size_t n_dofs = m.dof.n_dofs();
   const std::size_t expected = n_dofs + (m.cohesive_law ? 4 * m.cohesive_states.size() + 2 : 0) +
-                               (m.dynamics ? 2 * n_dofs + 1 : 0);
+                               (m.dynamics ? 2 * n_dofs + 2 : 0);
   if (values.size() != expected)
     throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values, expected " + std::to_string(expected) +
                                 " (" + std::to_string(n_dofs) + " DOFs" +
                                 (m.cohesive_law ? " + 4 per cohesive point + 2" : std::string()) +
-                                (m.dynamics ? " + velocity and acceleration per DOF + 1 (dynamic step)" : std::string()) + ")");
+                                (m.dynamics ? " + velocity and acceleration per DOF + 2 (dynamic step)" : std::string()) + ")");
   if (m.cohesive_law) {
     auto it = values.begin() + static_cast<std::ptrdiff_t>(n_dofs);
     for (CohesiveState& s : m.cohesive_states) {
@@ -1426,10 +1437,11 @@ void FiniteStrainSolver::set_state(const std::vector<double>& values) {
   if (!m.distributed) {
     std::copy(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(n_dofs), m.serial.u.begin());
     if (m.dynamics) {
-      auto it = values.end() - static_cast<std::ptrdiff_t>(2 * n_dofs + 1);
+      auto it = values.end() - static_cast<std::ptrdiff_t>(2 * n_dofs + 2);
       std::copy(it, it + static_cast<std::ptrdiff_t>(n_dofs), m.dynamics->v.begin());
       std::copy(it + static_cast<std::ptrdiff_t>(n_dofs), it + static_cast<std::ptrdiff_t>(2 * n_dofs), m.dynamics->a.begin());
-      m.committed_time = values.back();
+      m.committed_time = values.end()[-2];
+      m.cohesive_trapezoid_work = values.back();
       m.dynamics->step = 0.0;
       (void)m.commit_dynamics(m.serial.u); // u_n = u; the kinetic energy of the restored v
     }

@@ -158,6 +158,14 @@ struct CohesiveSummary {
   double stored_energy = 0.0;      ///< recoverable interface energy ∫ φ_e dA [J]
   double dissipated_energy = 0.0;  ///< cohesive dissipation ∫ φ_d(κ) dA, total so far [J]
   double viscous_dissipation = 0.0; ///< ∫∫ η |Δ̇|² dA dt, total so far [J]
+  /// Dynamic step only (0 otherwise): the work the interface's tractions (without the viscous
+  /// part) did in the time integration, Σ_steps ∫ ½ (t_n + t_{n+1})·(Δ_{n+1} − Δ_n) dA [J], the
+  /// trapezoidal rule that the Newmark average-acceleration energy identity books. It equals
+  /// stored_energy + dissipated_energy when the law is piecewise linear within every step; when a
+  /// point crosses a kink of the bilinear envelope within one step (peak or failure, above all a
+  /// ligament that opens past δ_f in one step), the difference is the time integration's error
+  /// at the kink, which shrinks with the time step.
+  double trapezoid_work = 0.0;
   double max_damage = 0.0;         ///< largest 1 − K(κ)/K_0 over the points
 };
 
@@ -250,7 +258,8 @@ public:
   /// order on every process (distributed: gathered; the numbering depends on the process count,
   /// so a state is restored with the same number of processes), followed (with a cohesive
   /// interface) by each interface point's history (κ, previous opening) and the last time, and
-  /// (with SolverSettings::dynamic) by the velocity and acceleration DOFs and the last time.
+  /// (with SolverSettings::dynamic) by the velocity and acceleration DOFs, the last time and the
+  /// interface's trapezoid work (CohesiveSummary::trapezoid_work).
   [[nodiscard]] std::vector<double> state() const;
   /// Restores a checkpointed state. Throws std::invalid_argument on a size mismatch.
   void set_state(const std::vector<double>& values);

@@ -99,7 +99,7 @@ bool resumable_record(const nlohmann::json& s) {
     const auto it = energy->find(key);
     if (it == energy->end() || !it->is_number()) return false;
   }
-  for (const char* key : {"contact_energy_J", "kinetic_energy_J"}) { // optional (absent in older records)
+  for (const char* key : {"contact_energy_J", "kinetic_energy_J", "cohesive_trapezoid_work_J"}) { // optional (older records)
     const auto it = energy->find(key);
     if (it != energy->end() && !it->is_number()) return false;
   }

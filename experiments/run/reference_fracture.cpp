@@ -81,10 +81,16 @@ void EnergyBookkeeping::add_sample(const std::vector<Eigen::Vector3d>& positions
   m_kinetic = kinetic_energy;
 }
 
+double EnergyBookkeeping::cohesive_time_integration() const {
+  // Only the dynamic step measures the trapezoid work (CohesiveSummary::trapezoid_work = 0 otherwise).
+  if (m_interface.trapezoid_work == 0.0) return 0.0;
+  return m_interface.trapezoid_work - m_interface.stored_energy - m_interface.dissipated_energy;
+}
+
 double EnergyBookkeeping::balance_error() const {
   const double accounted =
       m_strain + m_interface.stored_energy + m_contact + m_kinetic + m_interface.dissipated_energy +
-      m_interface.viscous_dissipation;
+      m_interface.viscous_dissipation + cohesive_time_integration();
   const double scale = std::max({std::abs(m_work), std::abs(accounted), 1e-300});
   return (m_work - accounted) / scale;
 }
@@ -102,6 +108,8 @@ nlohmann::json EnergyBookkeeping::to_json() const {
           {"kinetic_energy_J", m_kinetic},
           {"cohesive_dissipation_J", m_interface.dissipated_energy},
           {"viscous_dissipation_J", m_interface.viscous_dissipation},
+          {"cohesive_time_integration_J", cohesive_time_integration()},
+          {"cohesive_trapezoid_work_J", m_interface.trapezoid_work},
           {"friction_dissipation_J", 0.0},
           {"failed_area_m2", m_interface.failed_area},
           {"balance_error", balance_error()},
@@ -116,6 +124,7 @@ EnergyBookkeeping EnergyBookkeeping::from_json(const nlohmann::json& j) {
   e.m_interface.stored_energy = j.at("interface_energy_J").get<double>();
   e.m_contact = j.value("contact_energy_J", 0.0); // absent in checkpoints written before it was booked
   e.m_kinetic = j.value("kinetic_energy_J", 0.0); // absent in quasi-static runs' checkpoints before the dynamic step
+  e.m_interface.trapezoid_work = j.value("cohesive_trapezoid_work_J", 0.0); // likewise
   e.m_interface.dissipated_energy = j.at("cohesive_dissipation_J").get<double>();
   e.m_interface.viscous_dissipation = j.at("viscous_dissipation_J").get<double>();
   e.m_interface.failed_area = j.at("failed_area_m2").get<double>();

@@ -20,6 +20,7 @@
 //                  §9.1; exact for a linear system; the strain here is 10⁻⁴, so nearly linear)
 
 #include "reference/finite_strain_solver.hpp"
+#include "reference/load_path.hpp"
 #include "tests/reference/reference_test_meshes.hpp"
 
 #include <gtest/gtest.h>
@@ -80,6 +81,48 @@ TEST(DynamicBar, SuddenlyLoadedBarReachesTwiceTheStaticDisplacement) {
   EXPECT_NEAR(peak_time, 2.0 * L / c, 0.03 * 2.0 * L / c);
   EXPECT_NEAR(mean, u_static, 0.01 * u_static);
   EXPECT_LT(worst_energy, 1e-5); // measured 4e-7 (the law's nonlinearity at strain 1e-4)
+}
+
+// A cut-back restores the dynamic state: a load path whose first attempt at t = 2h fails (a NaN
+// injected in its residual, SolverSettings::residual_fault) cuts back to t = h and goes on to 2h; the
+// failed attempt must leave u, v and a as they were, so the result equals, bit for bit, the path
+// that solves t = h and t = 2h directly (the independent run).
+TEST(DynamicBar, CutBackRestoresVelocityAndAcceleration) {
+  const double L = 0.1, b = 0.01, E = 1e6, rho = 1000.0, sigma = 100.0, h = 1e-4;
+  auto problem = [&] {
+    FiniteStrainProblem p;
+    p.mesh = test::named_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(L, b, b), 10, 1, 1);
+    p.materials.push_back({"body", LawKind::neo_hookean, E, 0.0, rho});
+    p.displacement_boundaries.push_back({"xmin", DisplacementBoundary::Kind::bonded, {}, {}});
+    p.tractions.push_back({"xmax", Eigen::Vector3d(sigma * b * b, 0.0, 0.0)});
+    return p;
+  };
+  SolverSettings settings;
+  settings.dynamic = true;
+  // The paths start at load factor 1 (the load applied at t = 0, as above), so that a cut-back
+  // interpolates only the time.
+  FiniteStrainSolver direct(problem(), settings);
+  LoadPath direct_path(direct, LoadState{1.0, Eigen::Vector3d::Zero(), 0.0});
+  for (int k = 1; k <= 3; ++k) ASSERT_TRUE(direct_path.advance({{1.0, Eigen::Vector3d::Zero(), k * h}, 0, k * h}).converged);
+
+  int faults = 0;
+  settings.residual_fault = [&](const LoadState& load, int iteration) {
+    const bool fault = faults == 0 && std::abs(load.time - 2 * h) < 1e-12 && iteration == 1;
+    faults += fault ? 1 : 0;
+    return fault;
+  };
+  FiniteStrainSolver cut(problem(), settings);
+  LoadPath cut_path(cut, LoadState{1.0, Eigen::Vector3d::Zero(), 0.0});
+  // Target 2h from t = 0: the attempt with a step of 2h fails, the cut-back solves h, then 2h; then 3h.
+  const LoadStepReport first = cut_path.advance({{1.0, Eigen::Vector3d::Zero(), 2 * h}, 0, 2 * h});
+  ASSERT_TRUE(first.converged);
+  EXPECT_EQ(first.cutbacks, 1);
+  EXPECT_EQ(first.increments, 2);
+  ASSERT_TRUE(cut_path.advance({{1.0, Eigen::Vector3d::Zero(), 3 * h}, 0, 3 * h}).converged);
+  EXPECT_EQ(faults, 1);
+  EXPECT_EQ(cut.state(), direct.state()); // displacement, velocity, acceleration, time: bit for bit
+  EXPECT_EQ(cut.kinetic_energy(), direct.kinetic_energy());
+  EXPECT_GT(direct.kinetic_energy(), 0.0);
 }
 
 TEST(DynamicBar, RefusesAMaterialWithoutDensity) {
