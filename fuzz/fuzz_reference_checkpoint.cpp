@@ -1,6 +1,7 @@
 #include "fuzz/fuzz_targets.hpp"
 
 #include "experiments/run/reference_checkpoint.hpp"
+#include "experiments/run/reference_fracture.hpp"
 #include "fuzz/fuzz_input_file.hpp"
 
 namespace kerf::fuzz {
@@ -24,6 +25,7 @@ void fuzz_reference_checkpoint(std::span<const std::byte> data) {
   if (!c.samples.empty() && c.samples.back().contains("energy")) {
     (void)c.samples.back().at("contact_points").get<int>();
     (void)c.samples.back().at("energy").at("failed_area_m2").get<double>();
+    (void)EnergyBookkeeping::from_json(c.samples.back().at("energy")); // with the kinetic energy of a dynamic run
   }
   (void)newton_total;
 }

@@ -55,6 +55,7 @@
 #include <map>
 #include <span>
 #include <stdexcept>
+#include <type_traits>
 
 namespace kerf::reference {
 
@@ -153,6 +154,30 @@ struct FiniteStrainSolver::Impl {
   std::unique_ptr<dealii::QGaussSimplex<2>> face_quadrature;
   std::vector<std::unique_ptr<HyperelasticLaw>> laws; // by material_id
   std::vector<double> youngs; // by material_id
+  std::vector<double> densities; // by material_id [kg/m^3]
+
+  // Dynamic step (SolverSettings::dynamic; serial only): Newmark average acceleration with the
+  // consistent mass. Each cell's scalar mass matrix m_ij = ∫ ρ N_i N_j dV over its scalar shape
+  // functions (nodes × nodes, the same for the three components) is computed once in build. The
+  // committed state is u_n, v_n, a_n at `committed_time`; `step` is h of the solve under way
+  // (0: quasi-static, no inertia).
+  struct Dynamics {
+    std::vector<std::vector<double>> cell_mass; // by active cell index: nodes × nodes, row-major
+    std::vector<unsigned> node_of_dof;          // a cell's local DOF -> its scalar node (0 .. nodes-1)
+    unsigned nodes = 0;                         // scalar nodes per cell
+    dealii::Vector<double> u, v, a;             // u_n, v_n, a_n (all DOFs, global order)
+    double step = 0.0;                          // h [s] of the current solve
+    double kinetic_energy = 0.0;                // ½ v_nᵀ M v_n [J]
+  };
+  std::optional<Dynamics> dynamics;
+  void build_dynamics();
+  /// a_{n+1} at DOF i for the trial displacement u_i (Newmark β = 1/4: 4/h² (u − u_n) − 4/h v_n − a_n).
+  [[nodiscard]] double newmark_acceleration(dealii::types::global_dof_index i, double u) const {
+    const Dynamics& d = *dynamics;
+    return 4.0 / (d.step * d.step) * (u - d.u[i]) - 4.0 / d.step * d.v[i] - d.a[i];
+  }
+  /// Commits u_{n+1} (`u`): a_{n+1}, v_{n+1} = v_n + h/2 (a_n + a_{n+1}); returns ½ vᵀ M v.
+  double commit_dynamics(const dealii::Vector<double>& u);
 
   // Dirichlet DOFs and how to get their target value.
   struct DirichletDof {
@@ -224,6 +249,7 @@ struct FiniteStrainSolver::Impl {
   std::vector<CohesiveState> cohesive_states; // pair-major, then quadrature point
   std::vector<unsigned> cell_components;      // component of each local DOF of a cell
   double cohesive_viscous_dissipation = 0.0;
+  double cohesive_trapezoid_work = 0.0; // dynamic step only: CohesiveSummary::trapezoid_work
   double committed_time = 0.0;
   bool cohesive_secant = false; // Newton fallback: the secant interface tangent (cohesive_law.hpp)
   bool poison_residual = false; // fault injection: SolverSettings::residual_fault chose this assembly
@@ -317,6 +343,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
       if (material[static_cast<std::size_t>(t)] < 0) material[static_cast<std::size_t>(t)] = static_cast<int>(r);
     laws.push_back(make_law(problem.materials[r]));
     youngs.push_back(problem.materials[r].youngs_modulus);
+    densities.push_back(problem.materials[r].density);
   }
   std::vector<dealii::Point<3>> vertices(static_cast<std::size_t>(mesh.nodes.rows()));
   for (Eigen::Index v = 0; v < mesh.nodes.rows(); ++v)
@@ -500,6 +527,18 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     if (tool->kind == RigidToolShape::Kind::wedge) build_blade_edge();
   }
 
+  if (settings.dynamic) {
+    if (distributed)
+      throw std::invalid_argument("finite strain solver: the dynamic step runs on one process for now "
+                                  "(run without mpirun, or with -np 1)");
+    for (std::size_t r = 0; r < problem.materials.size(); ++r)
+      if (!(problem.materials[r].density > 0.0) || !std::isfinite(problem.materials[r].density))
+        throw std::invalid_argument("finite strain solver: the dynamic step needs a density > 0 for material region '" +
+                                    problem.materials[r].volume_group + "', got " +
+                                    std::to_string(problem.materials[r].density) + " kg/m^3");
+    build_dynamics();
+  }
+
   if (problem.cohesive) {
     if (distributed)
       throw std::invalid_argument("finite strain solver: the cohesive interface runs on one process for now "
@@ -655,6 +694,20 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
     cell_ext = 0.0;
     fv[disp].get_function_gradients(state, grads);
     const HyperelasticLaw& law = *laws[cell->material_id()];
+    if (dynamics && dynamics->step > 0.0) {
+      // Inertia (Newmark β = 1/4): f_a += Σ_b M_ab a_b(u), a_b = 4/h² (u_b − u_n,b) − 4/h v_n,b − a_n,b,
+      // and ∂f_a/∂u_b = 4/h² M_ab. M_ab = m_ij δ(c_a, c_b), m the cell's scalar mass matrix.
+      const Dynamics& d = *dynamics;
+      const std::vector<double>& m = d.cell_mass[cell->active_cell_index()];
+      const double c = 4.0 / (d.step * d.step);
+      for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = 0; j < n; ++j) {
+          if (comp[i] != comp[j]) continue;
+          const double Mij = m[d.node_of_dof[i] * d.nodes + d.node_of_dof[j]];
+          cell_int(i) += Mij * newmark_acceleration(local[j], state(local[j]));
+          if (with_matrix) cell_K(i, j) += c * Mij;
+        }
+    }
     for (unsigned q = 0; q < fv.n_quadrature_points; ++q) {
       // F = I + Grad u (total Lagrangian: gradients with respect to the reference configuration)
       const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(grads[q]);
@@ -735,6 +788,58 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
     }
   }
   if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);
+}
+
+void FiniteStrainSolver::Impl::build_dynamics() {
+  Dynamics d;
+  const dealii::FE_SimplexP<3> scalar(static_cast<unsigned>(settings.degree));
+  d.nodes = scalar.n_dofs_per_cell();
+  const unsigned n = fe->n_dofs_per_cell();
+  d.node_of_dof.resize(n);
+  for (unsigned i = 0; i < n; ++i) d.node_of_dof[i] = fe->system_to_component_index(i).second;
+  // m_ij = ∫ ρ N_i N_j dV with the cell quadrature (degree + 1 points per direction: exact for
+  // N_i N_j of P1; of P2 (degree 4) QGaussSimplex(3) is exact to degree 5).
+  dealii::FEValues<3> fv(*mapping, scalar, *cell_quadrature, dealii::update_values | dealii::update_JxW_values);
+  d.cell_mass.resize(tria.n_active_cells());
+  for (const auto& cell : tria.active_cell_iterators()) {
+    fv.reinit(cell);
+    const double rho = densities[cell->material_id()];
+    std::vector<double> m(static_cast<std::size_t>(d.nodes) * d.nodes, 0.0);
+    for (unsigned q = 0; q < fv.n_quadrature_points; ++q)
+      for (unsigned i = 0; i < d.nodes; ++i)
+        for (unsigned j = 0; j < d.nodes; ++j) m[i * d.nodes + j] += rho * fv.shape_value(i, q) * fv.shape_value(j, q) * fv.JxW(q);
+    d.cell_mass[cell->active_cell_index()] = std::move(m);
+  }
+  d.u.reinit(dof.n_dofs());
+  d.v.reinit(dof.n_dofs());
+  d.a.reinit(dof.n_dofs());
+  dynamics = std::move(d);
+}
+
+double FiniteStrainSolver::Impl::commit_dynamics(const dealii::Vector<double>& u) {
+  Dynamics& d = *dynamics;
+  if (d.step > 0.0)
+    for (dealii::types::global_dof_index i = 0; i < u.size(); ++i) {
+      // a_{n+1} (Newmark β = 1/4), then v_{n+1} = v_n + h/2 (a_n + a_{n+1}) (γ = 1/2)
+      const double a_next = newmark_acceleration(i, u[i]);
+      d.v[i] += 0.5 * d.step * (d.a[i] + a_next);
+      d.a[i] = a_next;
+    }
+  d.u = u;
+  // ½ vᵀ M v, cell by cell (M_ab = m_ij δ(c_a, c_b)).
+  const unsigned n = fe->n_dofs_per_cell();
+  std::vector<dealii::types::global_dof_index> local(n);
+  double kinetic = 0.0;
+  for (const auto& cell : dof.active_cell_iterators()) {
+    cell->get_dof_indices(local);
+    const std::vector<double>& m = d.cell_mass[cell->active_cell_index()];
+    for (unsigned i = 0; i < n; ++i)
+      for (unsigned j = 0; j < n; ++j)
+        if (fe->system_to_component_index(i).first == fe->system_to_component_index(j).first)
+          kinetic += 0.5 * d.v[local[i]] * m[d.node_of_dof[i] * d.nodes + d.node_of_dof[j]] * d.v[local[j]];
+  }
+  d.kinetic_energy = kinetic;
+  return kinetic;
 }
 
 void FiniteStrainSolver::Impl::build_blade_edge() {
@@ -1022,6 +1127,14 @@ CohesiveSummary FiniteStrainSolver::Impl::commit_cohesive(const LoadState& load)
       const CohesiveResponse r = cohesive_response(*cohesive_law, state, opening, cohesive_pairs[p].normal, dt);
       const double w = cohesive_pairs[p].weights[q];
       if (dt > 0.0) cohesive_viscous_dissipation += r.viscous_power_density * dt * w;
+      if (dynamics) {
+        // ½ (t_n + t_{n+1})·(Δ_{n+1} − Δ_n) without the viscous part (dt = 0): t_n is the traction at
+        // the last converged opening Δ_n with the damage κ_n reached there.
+        const Eigen::Vector3d& n = cohesive_pairs[p].normal;
+        const CohesiveResponse before = cohesive_response(*cohesive_law, state, state.previous_opening, n, 0.0);
+        const CohesiveResponse after = cohesive_law->viscosity > 0.0 ? cohesive_response(*cohesive_law, state, opening, n, 0.0) : r;
+        cohesive_trapezoid_work += 0.5 * (before.traction + after.traction).dot(opening - state.previous_opening) * w;
+      }
       state.max_opening = r.damage_opening;
       state.previous_opening = opening;
       if (r.failed) summary.failed_area += w;
@@ -1032,6 +1145,7 @@ CohesiveSummary FiniteStrainSolver::Impl::commit_cohesive(const LoadState& load)
     }
   committed_time = load.time;
   summary.viscous_dissipation = cohesive_viscous_dissipation;
+  summary.trapezoid_work = cohesive_trapezoid_work;
   return summary;
 }
 
@@ -1056,6 +1170,8 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
   VectorType rhs, du;
   la.reinit(rhs);
   la.reinit(du);
+  // Dynamic step: h from the last converged time (0: a quasi-static solve, no inertia).
+  if (m.dynamics) m.dynamics->step = std::max(0.0, load.time - m.committed_time);
   auto fail = [&](std::string why) {
     la.u = start;
     report.converged = false;
@@ -1151,6 +1267,10 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
     report.support_reaction += b.force;
   }
   if (m.cohesive_law) report.cohesive = m.commit_cohesive(load);
+  if (m.dynamics) {
+    if constexpr (std::is_same_v<VectorType, dealii::Vector<double>>) report.kinetic_energy = m.commit_dynamics(la.u);
+  }
+  m.committed_time = load.time;
   report.tool_force = -assembly.contact_on_body;
   report.traction_resultant = assembly.traction_on_body;
   report.force_imbalance = report.traction_resultant - report.tool_force - report.support_reaction;
@@ -1189,6 +1309,8 @@ double FiniteStrainSolver::max_displacement() const {
     best = std::max(best, std::sqrt(u[k] * u[k] + u[k + 1] * u[k + 1] + u[k + 2] * u[k + 2]));
   return best;
 }
+
+double FiniteStrainSolver::kinetic_energy() const { return m_impl->dynamics ? m_impl->dynamics->kinetic_energy : 0.0; }
 
 int FiniteStrainSolver::process_count() const { return m_impl->distributed ? m_impl->process_count : 1; }
 
@@ -1284,17 +1406,25 @@ std::vector<double> FiniteStrainSolver::state() const {
     values.push_back(m.committed_time);
     values.push_back(m.cohesive_viscous_dissipation);
   }
+  if (m.dynamics) { // serial only (build refuses a distributed dynamic step)
+    values.insert(values.end(), m.dynamics->v.begin(), m.dynamics->v.end());
+    values.insert(values.end(), m.dynamics->a.begin(), m.dynamics->a.end());
+    values.push_back(m.committed_time);
+    values.push_back(m.cohesive_trapezoid_work);
+  }
   return values;
 }
 
 void FiniteStrainSolver::set_state(const std::vector<double>& values) {
   Impl& m = *m_impl;
   const std::size_t n_dofs = m.dof.n_dofs();
-  const std::size_t expected = n_dofs + (m.cohesive_law ? 4 * m.cohesive_states.size() + 2 : 0);
+  const std::size_t expected = n_dofs + (m.cohesive_law ? 4 * m.cohesive_states.size() + 2 : 0) +
+                               (m.dynamics ? 2 * n_dofs + 2 : 0);
   if (values.size() != expected)
     throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values, expected " + std::to_string(expected) +
                                 " (" + std::to_string(n_dofs) + " DOFs" +
-                                (m.cohesive_law ? " + 4 per cohesive point + 2" : std::string()) + ")");
+                                (m.cohesive_law ? " + 4 per cohesive point + 2" : std::string()) +
+                                (m.dynamics ? " + velocity and acceleration per DOF + 2 (dynamic step)" : std::string()) + ")");
   if (m.cohesive_law) {
     auto it = values.begin() + static_cast<std::ptrdiff_t>(n_dofs);
     for (CohesiveState& s : m.cohesive_states) {
@@ -1306,6 +1436,15 @@ void FiniteStrainSolver::set_state(const std::vector<double>& values) {
   }
   if (!m.distributed) {
     std::copy(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(n_dofs), m.serial.u.begin());
+    if (m.dynamics) {
+      auto it = values.end() - static_cast<std::ptrdiff_t>(2 * n_dofs + 2);
+      std::copy(it, it + static_cast<std::ptrdiff_t>(n_dofs), m.dynamics->v.begin());
+      std::copy(it + static_cast<std::ptrdiff_t>(n_dofs), it + static_cast<std::ptrdiff_t>(2 * n_dofs), m.dynamics->a.begin());
+      m.committed_time = values.end()[-2];
+      m.cohesive_trapezoid_work = values.back();
+      m.dynamics->step = 0.0;
+      (void)m.commit_dynamics(m.serial.u); // u_n = u; the kinetic energy of the restored v
+    }
     return;
   }
   DistributedAlgebra& la = *m.parallel;

@@ -45,6 +45,9 @@ struct MaterialRegion {
   LawKind law = LawKind::neo_hookean;
   double youngs_modulus = 0.0; ///< E [Pa] > 0
   double poisson_ratio = 0.0;  ///< ν in (-1, 0.5)
+  /// ρ [kg/m^3] in the reference configuration: the consistent mass of the dynamic step
+  /// (SolverSettings::dynamic; must then be > 0), unused by the quasi-static solve.
+  double density = 0.0;
 };
 
 /// A displacement condition on a named TetMesh surface group.
@@ -134,6 +137,17 @@ struct SolverSettings {
   /// material or contact term would make it. `solve` must take it for failure (state restored,
   /// converged false), never for convergence, so the load path cuts back or stops.
   std::function<bool(const LoadState& load, int newton_iteration)> residual_fault;
+  /// Dynamic (inertial) step instead of the quasi-static one: implicit Newmark average acceleration
+  /// (Newmark 1959, β = 1/4, γ = 1/2; Hughes, The Finite Element Method, §9.1: the trapezoidal rule,
+  /// unconditionally stable, no numerical dissipation) with the consistent mass M_ab = ∫ ρ N_a N_b dV
+  /// of FE_SimplexP (cell matrices computed once). Each solve finds u_{n+1} with
+  ///   M a_{n+1} + f_int(u_{n+1}) = f_ext,   a_{n+1} = 4/h² (u_{n+1} − u_n) − 4/h v_n − a_n,
+  ///   v_{n+1} = v_n + h/2 (a_n + a_{n+1}),   h = LoadState::time − the last converged time,
+  /// Newton's tangent gaining 4 M/h². A solve at the same time as the last one (h = 0, e.g. the
+  /// first sample) is quasi-static and leaves v and a unchanged; the body starts at rest (v = a = 0).
+  /// Reactions (and the tool forces of tied styluses) include the inertia of the driven nodes.
+  /// Serial only (a distributed mesh is refused). Every material region needs a density > 0.
+  bool dynamic = false;
 };
 
 /// The cohesive interface after a converged solve (all zero without one). Energies per the whole
@@ -144,6 +158,14 @@ struct CohesiveSummary {
   double stored_energy = 0.0;      ///< recoverable interface energy ∫ φ_e dA [J]
   double dissipated_energy = 0.0;  ///< cohesive dissipation ∫ φ_d(κ) dA, total so far [J]
   double viscous_dissipation = 0.0; ///< ∫∫ η |Δ̇|² dA dt, total so far [J]
+  /// Dynamic step only (0 otherwise): the work the interface's tractions (without the viscous
+  /// part) did in the time integration, Σ_steps ∫ ½ (t_n + t_{n+1})·(Δ_{n+1} − Δ_n) dA [J], the
+  /// trapezoidal rule that the Newmark average-acceleration energy identity books. It equals
+  /// stored_energy + dissipated_energy when the law is piecewise linear within every step; when a
+  /// point crosses a kink of the bilinear envelope within one step (peak or failure, above all a
+  /// ligament that opens past δ_f in one step), the difference is the time integration's error
+  /// at the kink, which shrinks with the time step.
+  double trapezoid_work = 0.0;
   double max_damage = 0.0;         ///< largest 1 − K(κ)/K_0 over the points
 };
 
@@ -178,6 +200,8 @@ struct EquilibriumReport {
   /// Energy stored in the tool's penalty contact [J]: ∫ ½ ε_N p² dA over the flank points plus
   /// Σ ½ ε_L w d² over the edge points (the potentials whose derivatives are the contact forces).
   double contact_energy = 0.0;
+  /// Kinetic energy ½ vᵀ M v [J] after this solve (0 for the quasi-static step).
+  double kinetic_energy = 0.0;
   double assembly_seconds = 0.0;
   double linear_solve_seconds = 0.0;
   int linear_iterations = 0; ///< iterative solver: total CG iterations
@@ -227,11 +251,15 @@ public:
   [[nodiscard]] double strain_energy() const;
   /// Largest displacement magnitude over the DOFs [m].
   [[nodiscard]] double max_displacement() const;
+  /// Kinetic energy ½ vᵀ M v [J] of the last converged state (0 without SolverSettings::dynamic).
+  [[nodiscard]] double kinetic_energy() const;
 
   /// The state for a checkpoint: the DOF values of the displacement, all of them in global DOF
   /// order on every process (distributed: gathered; the numbering depends on the process count,
   /// so a state is restored with the same number of processes), followed (with a cohesive
-  /// interface) by each interface point's history (κ, previous opening) and the last time.
+  /// interface) by each interface point's history (κ, previous opening) and the last time, and
+  /// (with SolverSettings::dynamic) by the velocity and acceleration DOFs, the last time and the
+  /// interface's trapezoid work (CohesiveSummary::trapezoid_work).
   [[nodiscard]] std::vector<double> state() const;
   /// Restores a checkpointed state. Throws std::invalid_argument on a size mismatch.
   void set_state(const std::vector<double>& values);

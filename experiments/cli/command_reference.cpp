@@ -1,6 +1,6 @@
 // kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [--until T] [--levels L]
 // [--element-size H] [-o DIR] [--resume] [--no-fields] [--solver auto|direct|iterative] [--np N]
-// [--fracture auto|on|off] [--cohesive-viscous-time TAU]: the finite-strain reference along the
+// [--fracture auto|on|off] [--cohesive-viscous-time TAU] [--dynamic]: the finite-strain reference along the
 // scene's trajectory (issue 3),
 // written as profile.csv + manifest.json (+ fields.pvd), with a progress line per sample and
 // checkpoints to resume from; with --levels, a mesh convergence study over L refinements. `--np N`
@@ -47,6 +47,7 @@ struct ReferenceOptions {
   bool resume = false;
   std::string fracture = "off";
   double viscous_time = 0.0; ///< τ [s] of the cohesive law's viscous regularisation (0: none)
+  bool dynamic = false;      ///< the dynamic (inertial) step instead of the quasi-static one
   bool no_fields = false;
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
   reference::LinearSolverChoice solver = reference::LinearSolverChoice::automatic;
@@ -68,6 +69,7 @@ struct ReferenceOptions {
   if (!o.element_size.empty()) args.insert(args.end(), {"--element-size", o.element_size});
   args.insert(args.end(), {"--fracture", o.fracture});
   if (o.viscous_time > 0.0) args.insert(args.end(), {"--cohesive-viscous-time", std::to_string(o.viscous_time)});
+  if (o.dynamic) args.emplace_back("--dynamic");
   if (!o.out.empty()) args.insert(args.end(), {"-o", o.out});
   if (o.resume) args.emplace_back("--resume");
   if (o.no_fields) args.emplace_back("--no-fields");
@@ -109,6 +111,7 @@ void run_reference_command(const ReferenceOptions& o) {
   settings.linear_solver = o.solver;
   settings.fracture = o.fracture == "on" ? ReferenceFracture::on : o.fracture == "off" ? ReferenceFracture::off : ReferenceFracture::automatic;
   settings.cohesive_viscous_time = o.viscous_time;
+  settings.dynamic = o.dynamic;
   if (o.samples < 0) throw std::invalid_argument("--samples must be >= 1, got " + std::to_string(o.samples));
   if (o.samples > 0 || o.until >= 0.0) {
     if (scene.tools.empty()) throw std::invalid_argument("scene '" + scene.name + "' has no tool");
@@ -188,6 +191,9 @@ void add_reference_command(CLI::App& app) {
                   "viscous regularisation of the cohesive law (Gao & Bower 2004): relaxation time TAU in seconds, "
                   "eta = sigma_c TAU / delta_f (default 0: none); its dissipation is in the manifest's energy")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--dynamic", options->dynamic,
+                "dynamic (inertial) step: implicit Newmark average acceleration with the consistent mass of the "
+                "scene's density; the kinetic energy joins the manifest's energy (serial only)");
   cmd->add_option("--trajectory", options->trajectory,
                   "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   cmd->callback([options] { run_reference_command(*options); });

@@ -13,7 +13,9 @@ namespace kerf {
 
 namespace {
 
-constexpr char checkpoint_magic[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '2'};
+constexpr char checkpoint_magic[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '3'};
+/// Version 2 (before the dynamic step): no time-integration field; read as quasi-static.
+constexpr char checkpoint_magic_v2[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '2'};
 
 class Writer {
 public:
@@ -97,6 +99,10 @@ bool resumable_record(const nlohmann::json& s) {
     const auto it = energy->find(key);
     if (it == energy->end() || !it->is_number()) return false;
   }
+  for (const char* key : {"contact_energy_J", "kinetic_energy_J", "cohesive_trapezoid_work_J"}) { // optional (older records)
+    const auto it = energy->find(key);
+    if (it != energy->end() && !it->is_number()) return false;
+  }
   for (const char* key : {"last_positions_m", "last_forces_on_body_N"}) {
     const auto it = energy->find(key);
     if (it == energy->end() || !it->is_array()) return false;
@@ -118,6 +124,7 @@ void write_reference_checkpoint(const ReferenceCheckpoint& c, const std::filesys
     w.i32(c.degree);
     w.i32(c.refinements);
     w.i32(c.processes);
+    w.i32(c.dynamic ? 1 : 0);
     w.u64(c.indices.size());
     for (std::size_t i : c.indices) w.u64(i);
     w.u64(c.solved);
@@ -147,7 +154,9 @@ ReferenceCheckpoint read_reference_checkpoint(const std::filesystem::path& file)
   if (!in) throw std::runtime_error("reference: cannot read checkpoint " + file.string());
   char magic[8];
   in.read(magic, sizeof magic);
-  if (!in || !std::equal(magic, magic + 8, checkpoint_magic))
+  if (!in) throw std::runtime_error("reference checkpoint " + file.string() + ": not a kerf reference checkpoint");
+  const bool version_2 = std::equal(magic, magic + 8, checkpoint_magic_v2);
+  if (!version_2 && !std::equal(magic, magic + 8, checkpoint_magic))
     throw std::runtime_error("reference checkpoint " + file.string() + ": not a kerf reference checkpoint");
   std::error_code size_error;
   const std::uint64_t bytes = std::filesystem::file_size(file, size_error);
@@ -158,6 +167,12 @@ ReferenceCheckpoint read_reference_checkpoint(const std::filesystem::path& file)
   c.degree = r.pod<std::int32_t>();
   c.refinements = r.pod<std::int32_t>();
   c.processes = r.pod<std::int32_t>();
+  if (!version_2) {
+    const auto integration = r.pod<std::int32_t>();
+    if (integration != 0 && integration != 1)
+      throw std::runtime_error("reference checkpoint " + file.string() + ": corrupt time integration");
+    c.dynamic = integration == 1;
+  }
   c.indices.resize(r.count(sizeof(std::uint64_t)));
   for (std::size_t& i : c.indices) i = r.u64();
   c.solved = r.u64();

@@ -2,9 +2,12 @@
 // The reference run's checkpoint (reference_run.hpp: dir/checkpoint.bin, written every few solved
 // samples and at a stop, read by `kerf reference --resume`). Binary, native byte order (a
 // checkpoint is resumed on the machine that wrote it):
-// "KERFREF2", scene sha256, degree, refinements, process count, sample indices, targets solved,
-// the last converged load, the solver state (global DOF order, which depends on the process
-// count), the profile rows, the per-sample manifest records (JSON), the solve seconds.
+// "KERFREF3", scene sha256, degree, refinements, process count, time integration (0 quasi-static,
+// 1 dynamic), sample indices, targets solved, the last converged load, the solver state (global
+// DOF order, which depends on the process count; a dynamic run's also holds the velocity and
+// acceleration), the profile rows, the per-sample manifest records (JSON), the solve seconds.
+// Version 2 ("KERFREF2", written before the dynamic step) is the same without the time
+// integration and is read as quasi-static.
 //
 // Includes reference/*.hpp only, which include no deal.II.
 
@@ -25,6 +28,7 @@ struct ReferenceCheckpoint {
   std::string scene_sha256;
   int degree = 0, refinements = 0;
   int processes = 1; ///< MPI processes the mesh was distributed over
+  bool dynamic = false; ///< the run's time integration: the dynamic step (ReferenceRunSettings::dynamic)
   std::vector<std::size_t> indices; ///< trajectory samples the run solves
   std::size_t solved = 0;           ///< how many of `indices` are solved
   reference::LoadState last;        ///< the last converged load (its time is not stored)

@@ -65,7 +65,8 @@ CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem&
 }
 
 void EnergyBookkeeping::add_sample(const std::vector<Eigen::Vector3d>& positions, const std::vector<Eigen::Vector3d>& forces,
-                                   double strain_energy, const reference::CohesiveSummary& interface, double contact_energy) {
+                                   double strain_energy, const reference::CohesiveSummary& interface, double contact_energy,
+                                   double kinetic_energy) {
   if (positions.size() != forces.size()) throw std::invalid_argument("energy bookkeeping: one force per tool position");
   if (!m_positions.empty()) {
     if (m_positions.size() != positions.size()) throw std::invalid_argument("energy bookkeeping: the tool count changed");
@@ -77,11 +78,19 @@ void EnergyBookkeeping::add_sample(const std::vector<Eigen::Vector3d>& positions
   m_strain = strain_energy;
   m_interface = interface;
   m_contact = contact_energy;
+  m_kinetic = kinetic_energy;
+}
+
+double EnergyBookkeeping::cohesive_time_integration() const {
+  // Only the dynamic step measures the trapezoid work (CohesiveSummary::trapezoid_work = 0 otherwise).
+  if (m_interface.trapezoid_work == 0.0) return 0.0;
+  return m_interface.trapezoid_work - m_interface.stored_energy - m_interface.dissipated_energy;
 }
 
 double EnergyBookkeeping::balance_error() const {
   const double accounted =
-      m_strain + m_interface.stored_energy + m_contact + m_interface.dissipated_energy + m_interface.viscous_dissipation;
+      m_strain + m_interface.stored_energy + m_contact + m_kinetic + m_interface.dissipated_energy +
+      m_interface.viscous_dissipation + cohesive_time_integration();
   const double scale = std::max({std::abs(m_work), std::abs(accounted), 1e-300});
   return (m_work - accounted) / scale;
 }
@@ -96,8 +105,11 @@ nlohmann::json EnergyBookkeeping::to_json() const {
           {"stored_elastic_energy_J", m_strain},
           {"interface_energy_J", m_interface.stored_energy},
           {"contact_energy_J", m_contact},
+          {"kinetic_energy_J", m_kinetic},
           {"cohesive_dissipation_J", m_interface.dissipated_energy},
           {"viscous_dissipation_J", m_interface.viscous_dissipation},
+          {"cohesive_time_integration_J", cohesive_time_integration()},
+          {"cohesive_trapezoid_work_J", m_interface.trapezoid_work},
           {"friction_dissipation_J", 0.0},
           {"failed_area_m2", m_interface.failed_area},
           {"balance_error", balance_error()},
@@ -111,6 +123,8 @@ EnergyBookkeeping EnergyBookkeeping::from_json(const nlohmann::json& j) {
   e.m_strain = j.at("stored_elastic_energy_J").get<double>();
   e.m_interface.stored_energy = j.at("interface_energy_J").get<double>();
   e.m_contact = j.value("contact_energy_J", 0.0); // absent in checkpoints written before it was booked
+  e.m_kinetic = j.value("kinetic_energy_J", 0.0); // absent in quasi-static runs' checkpoints before the dynamic step
+  e.m_interface.trapezoid_work = j.value("cohesive_trapezoid_work_J", 0.0); // likewise
   e.m_interface.dissipated_energy = j.at("cohesive_dissipation_J").get<double>();
   e.m_interface.viscous_dissipation = j.at("viscous_dissipation_J").get<double>();
   e.m_interface.failed_area = j.at("failed_area_m2").get<double>();

@@ -34,6 +34,7 @@ reference::MaterialRegion region_of(const Material& m) {
   r.law = m.law == MaterialLaw::neo_hookean ? LawKind::neo_hookean : LawKind::st_venant_kirchhoff;
   r.youngs_modulus = m.youngs_modulus;
   r.poisson_ratio = m.poisson_ratio;
+  r.density = m.density;
   return r;
 }
 
@@ -264,6 +265,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   solver_settings.linear_solver = settings.linear_solver;
   solver_settings.distribute = settings.distribute;
   solver_settings.residual_fault = settings.residual_fault;
+  solver_settings.dynamic = settings.dynamic;
   reference::FiniteStrainSolver solver(rp.problem, solver_settings);
   // Under mpirun every process runs this function; rank 0 writes the files and the progress. A
   // solver that is not distributed (settings.distribute false: e.g. one of the solves `mpirun kerf
@@ -278,6 +280,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   cp.degree = settings.degree;
   cp.refinements = settings.refinements;
   cp.processes = solver.process_count();
+  cp.dynamic = settings.dynamic;
   cp.indices = indices;
   cp.last = load_of(0);
   std::optional<std::size_t> resumed_from;
@@ -290,6 +293,11 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                "count differ; it was written by " +
                                std::to_string(saved.processes) + " process(es), this run has " +
                                std::to_string(cp.processes) + ")");
+    if (saved.dynamic != cp.dynamic)
+      throw std::runtime_error("reference: " + checkpoint_file.string() + " is from a " +
+                               (saved.dynamic ? "dynamic" : "quasi-static") + " run and this run is " +
+                               (cp.dynamic ? "dynamic (--dynamic)" : "quasi-static") +
+                               ": resume with the same time integration");
     solver.set_state(saved.state);
     cp = std::move(saved);
     cp.last.time = cp.last.load_factor * T; // the load factor is t/T (load_of), also between samples
@@ -364,7 +372,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     }
     previous_interface = interface;
     energy.add_sample(tool_positions, forces_on_body, solver.strain_energy(), step.equilibrium.cohesive,
-                      step.equilibrium.contact_energy);
+                      step.equilibrium.contact_energy, solver.kinetic_energy());
     for (std::size_t j = 0; j < rp.tools.size(); ++j) {
       ProfileRow row;
       row.t = rp.times[k];
@@ -436,6 +444,8 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                   {"refinements", settings.refinements},
                   {"samples_requested", indices.size()},
                   {"checkpoint_every", settings.checkpoint_every},
+                  {"time_integration", settings.dynamic ? "dynamic: Newmark average acceleration (beta = 1/4, gamma = 1/2), consistent mass"
+                                                        : "quasi-static"},
                   {"write_fields", settings.write_fields}}}};
   m["mesh"] = {{"nodes", mesh.nodes.rows()},
                {"tetrahedra", mesh.tets.rows()},

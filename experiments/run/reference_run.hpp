@@ -42,6 +42,11 @@ struct ReferenceRunSettings {
   /// Viscous regularisation of the cohesive law: relaxation time τ [s] >= 0, η = σ_c τ / δ_f
   /// (add_crack_path); 0 = none. Its dissipation is booked in the manifest's energy.
   double cohesive_viscous_time = 0.0;
+  /// The dynamic (inertial) step (reference::SolverSettings::dynamic: Newmark average acceleration,
+  /// consistent mass from the scene's density) instead of the quasi-static one; the kinetic energy
+  /// joins the manifest's energy. The time step is the spacing of the solved samples (halved by the
+  /// load path's cut-backs). Serial only.
+  bool dynamic = false;
   /// Fault injection for tests (issue 10): passed to the solver as
   /// reference::SolverSettings::residual_fault (a NaN in the chosen Newton iterations' residual).
   std::function<bool(const reference::LoadState& load, int newton_iteration)> residual_fault;

@@ -170,6 +170,7 @@ TEST(FuzzRegressions, CorruptReferenceCheckpointsAreErrorsNotJsonExceptionsOrHug
   c.degree = 2;
   c.refinements = 1;
   c.processes = 3;
+  c.dynamic = true;
   c.indices = {0, 4, 8};
   c.solved = 2;
   c.last.load_factor = 0.5;
@@ -197,12 +198,50 @@ TEST(FuzzRegressions, CorruptReferenceCheckpointsAreErrorsNotJsonExceptionsOrHug
   EXPECT_EQ(back.profile.rows[1].force, c.profile.rows[1].force);
   EXPECT_EQ(back.samples, c.samples);
   EXPECT_EQ(back.solve_seconds, 1.25);
+  EXPECT_TRUE(back.dynamic);
+
+  // Version 2 (before the dynamic step; the saved regression inputs above are version 2 too):
+  // the same bytes without the time-integration field after the process count, read as a
+  // quasi-static run. Offset of that field: magic 8 + sha (8 + 64) + degree, refinements,
+  // processes 3 × 4 = 92.
+  {
+    std::ifstream in(file, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_EQ(bytes.substr(0, 8), "KERFREF3");
+    std::string v2 = bytes;
+    v2[7] = '2';
+    v2.erase(92, 4);
+    const fs::path old_file = scratch("checkpoint_v2.bin");
+    std::ofstream(old_file, std::ios::binary) << v2;
+    const ReferenceCheckpoint old = read_reference_checkpoint(old_file);
+    EXPECT_FALSE(old.dynamic);
+    EXPECT_EQ(old.indices, c.indices);
+    EXPECT_EQ(old.state, c.state);
+    EXPECT_EQ(old.samples, c.samples);
+    // A time-integration value other than 0 or 1 is a corrupt file.
+    std::string bad = bytes;
+    bad[92] = 7;
+    std::ofstream(old_file, std::ios::binary) << bad;
+    EXPECT_NE(message(old_file).find("corrupt time integration"), std::string::npos);
+  }
 
   // Records run_reference could not resume from.
   for (const nlohmann::json& bad : {nlohmann::json{{"newton_iterations", 1e300}, {"contact_points", 0}},
                                     nlohmann::json{{"newton_iterations", "3"}, {"contact_points", 0}},
                                     nlohmann::json{{"newton_iterations", 3}},
-                                    nlohmann::json{{"newton_iterations", 3}, {"contact_points", 0}, {"energy", 1}}}) {
+                                    nlohmann::json{{"newton_iterations", 3}, {"contact_points", 0}, {"energy", 1}},
+                                    nlohmann::json{{"newton_iterations", 3},
+                                                   {"contact_points", 0},
+                                                   {"energy",
+                                                    {{"external_work_J", 1.0},
+                                                     {"stored_elastic_energy_J", 1.0},
+                                                     {"interface_energy_J", 0.0},
+                                                     {"cohesive_dissipation_J", 0.0},
+                                                     {"viscous_dissipation_J", 0.0},
+                                                     {"failed_area_m2", 0.0},
+                                                     {"kinetic_energy_J", "0"},
+                                                     {"last_positions_m", nlohmann::json::array()},
+                                                     {"last_forces_on_body_N", nlohmann::json::array()}}}}}) {
     ReferenceCheckpoint corrupt = c;
     corrupt.samples[1] = bad;
     write_reference_checkpoint(corrupt, file);

@@ -143,6 +143,50 @@ TEST(ReferenceRun, ResumeFromACheckpointGivesTheUninterruptedProfile) {
   EXPECT_THROW(run_reference(c.scene, c.mesh, s, dir), std::runtime_error);
 }
 
+// The dynamic step's checkpoint carries the velocity and acceleration: a run resumed from it gives
+// the uninterrupted run's forces and kinetic energy bit for bit (without them the first resumed
+// step would start from rest and differ), and a quasi-static run's checkpoint is refused by a
+// dynamic run, naming the time integration.
+TEST(ReferenceRun, DynamicResumeCarriesVelocityAndAcceleration) {
+  const ClayPull c;
+  ReferenceRunSettings s;
+  s.sample_indices = reference_sample_indices(c.samples, 5);
+  s.write_fields = false;
+  s.checkpoint_every = 3;
+  s.dynamic = true;
+  const fs::path whole_dir = scratch("dynamic_whole");
+  const ForceProfile whole = run_reference(c.scene, c.mesh, s, whole_dir);
+  const nlohmann::json whole_manifest = read_json(whole_dir / "manifest.json");
+  EXPECT_GT(whole_manifest.at("energy").at("kinetic_energy_J").get<double>(), 0.0);
+
+  const fs::path dir = scratch("dynamic_interrupted");
+  run_reference(c.scene, c.mesh, s, dir);
+  fs::remove(dir / "profile.csv");
+  fs::remove(dir / "manifest.json");
+  s.resume = true;
+  const ForceProfile resumed = run_reference(c.scene, c.mesh, s, dir);
+  const nlohmann::json m = read_json(dir / "manifest.json");
+  EXPECT_EQ(m.at("resumed_after_sample"), 3);
+  ASSERT_EQ(resumed.rows.size(), whole.rows.size());
+  for (std::size_t k = 0; k < whole.rows.size(); ++k)
+    EXPECT_EQ(resumed.rows[k].force, whole.rows[k].force) << "row " << k; // bit for bit
+  EXPECT_EQ(m.at("energy").at("kinetic_energy_J"), whole_manifest.at("energy").at("kinetic_energy_J"));
+
+  // A quasi-static run's checkpoint, resumed by a dynamic run.
+  ReferenceRunSettings quasi_static = s;
+  quasi_static.dynamic = false;
+  quasi_static.resume = false;
+  const fs::path other = scratch("dynamic_refused");
+  run_reference(c.scene, c.mesh, quasi_static, other);
+  std::string message;
+  try {
+    run_reference(c.scene, c.mesh, s, other);
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("quasi-static run and this run is dynamic"), std::string::npos) << message;
+}
+
 // Fault injection (issue 10, docs/reliability.md): a NaN in the assembled residual of a Newton
 // iteration (reference::SolverSettings::residual_fault), as an overflowing material or contact term
 // would make it.
