@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <system_error>
 
 namespace kerf::fuzz {
@@ -39,8 +40,12 @@ void fuzz_study(std::span<const std::byte> data) {
       if (find_model(model) == nullptr) throw FuzzFinding("a study was accepted with a model not in the catalogue");
     const StudyReferenceSpec& r = spec.reference;
     if (r.degree != 1 && r.degree != 2) throw FuzzFinding("a study was accepted with a degree other than 1 or 2");
-    if (r.refinements.empty() || std::any_of(r.refinements.begin(), r.refinements.end(), [](int l) { return l < 0 || l > 4; }))
-      throw FuzzFinding("a study was accepted with a mesh level outside 0..4");
+    if (r.refinements.empty() || std::any_of(r.refinements.begin(), r.refinements.end(), [](int l) {
+          return l < minimum_study_mesh_level || l > 4;
+        }))
+      throw FuzzFinding("a study was accepted with a mesh level outside minimum_study_mesh_level..4");
+    if (std::adjacent_find(r.refinements.begin(), r.refinements.end(), std::greater_equal<>()) != r.refinements.end())
+      throw FuzzFinding("a study was accepted with mesh levels not strictly ascending");
     if (r.samples < 2) throw FuzzFinding("a study was accepted with fewer than 2 reference samples");
     for (const auto& calibration : spec.calibrations) {
       const std::string& scene = calibration.first;
