@@ -576,6 +576,8 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
     const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], m = pi[s + 1] - psi - nscol;
     const int pb = panel_rows(m);
     float* xs = x + k1;
+    // x_s's entry j, zero past the supernode's last column (a panel pass takes four columns)
+    const auto xj = [xs, nscol](int j) { return j < nscol ? xs[j] : 0.0f; };
     if (whole_inverted_block(nscol)) {
       // r = W x_s,  x_s ← r_top,  x_b += r_below  (W's lower part is −R T⁻¹)
       const int nsrow = nscol + m;
@@ -584,9 +586,8 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
       const float* panel = blocks + at[s];
       for (int c = 0; c < nscol; c += 4) {
         const int padded = panel_rows(nsrow - c);
-        panel_product(panel, column(panel, 1, padded), column(panel, 2, padded), column(panel, 3, padded), xs[c],
-                      c + 1 < nscol ? xs[c + 1] : 0.0f, c + 2 < nscol ? xs[c + 2] : 0.0f, c + 3 < nscol ? xs[c + 3] : 0.0f, padded,
-                      r + c);
+        panel_product(panel, column(panel, 1, padded), column(panel, 2, padded), column(panel, 3, padded), xs[c], xj(c + 1),
+                      xj(c + 2), xj(c + 3), padded, r + c);
         panel += 4 * static_cast<std::ptrdiff_t>(padded);
       }
       for (int j = 0; j < nscol; ++j) xs[j] = r[j];
@@ -600,8 +601,8 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
     const float* panel = blocks + at[s];
     for (int c = 0; c < nscol; c += 4) {
       const int pt = panel_rows(nscol - c), stride = pt + pb;
-      panel_product(panel, column(panel, 1, stride), column(panel, 2, stride), column(panel, 3, stride), xs[c],
-                    c + 1 < nscol ? xs[c + 1] : 0.0f, c + 2 < nscol ? xs[c + 2] : 0.0f, c + 3 < nscol ? xs[c + 3] : 0.0f, pt, top + c);
+      panel_product(panel, column(panel, 1, stride), column(panel, 2, stride), column(panel, 3, stride), xs[c], xj(c + 1),
+                    xj(c + 2), xj(c + 3), pt, top + c);
       panel += 4 * static_cast<std::ptrdiff_t>(stride);
     }
     for (int j = 0; j < nscol; ++j) xs[j] = top[j];
@@ -612,7 +613,7 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
     for (int c = 0; c < nscol; c += 4) {
       const int pt = panel_rows(nscol - c), stride = pt + pb;
       panel_product(panel + pt, column(panel, 1, stride) + pt, column(panel, 2, stride) + pt, column(panel, 3, stride) + pt, xs[c],
-                    c + 1 < nscol ? xs[c + 1] : 0.0f, c + 2 < nscol ? xs[c + 2] : 0.0f, c + 3 < nscol ? xs[c + 3] : 0.0f, pb, bottom);
+                    xj(c + 1), xj(c + 2), xj(c + 3), pb, bottom);
       panel += 4 * static_cast<std::ptrdiff_t>(stride);
     }
     const int* __restrict below = ls + psi + nscol;
