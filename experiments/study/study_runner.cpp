@@ -205,6 +205,22 @@ void write_text(const std::filesystem::path& file, const std::string& text) {
   });
 }
 
+/// A `not run:` note goes into tables that are published (docs/results.md), so the scene file's
+/// path in the model's message is written relative to the directory the study runs in (the
+/// repository root for `kerf study default`), or as the file's name when the scene lies outside
+/// it: the table then reads the same on every checkout.
+std::string portable_note(std::string note, const Scene& scene) {
+  namespace fs = std::filesystem;
+  if (!scene.file.is_absolute()) return note;
+  std::error_code error;
+  fs::path shown = fs::relative(scene.file, fs::current_path(error), error);
+  if (error || shown.empty() || *shown.begin() == "..") shown = scene.file.filename();
+  const std::string absolute = scene.file.string();
+  for (std::size_t at = note.find(absolute); at != std::string::npos; at = note.find(absolute, at + 1))
+    note.replace(at, absolute.size(), shown.string());
+  return note;
+}
+
 std::string read_text(const std::filesystem::path& file) {
   std::ifstream f(file);
   std::ostringstream s;
@@ -298,7 +314,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
         represented = represented_phenomena(model, scene);
       } catch (const ModelMismatch& e) {
         // Not applicable: a row without numbers whose note says why.
-        model_runs.push_back({index, model, model, scene, out / scene.name / model, {}, std::string("not run: ") + e.what()});
+        model_runs.push_back({index, model, model, scene, out / scene.name / model, {}, portable_note(std::string("not run: ") + e.what(), scene)});
         continue;
       }
       model_runs.push_back({index, model, model, scene, out / scene.name / model, represented, ""});

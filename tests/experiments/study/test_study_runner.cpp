@@ -170,6 +170,27 @@ TEST(StudyRunner, AModelThatCannotRunOnASceneHasARowSayingWhy) {
   fs::remove_all(out);
 }
 
+TEST(StudyRunner, ANotRunNoteCarriesNoAbsolutePath) {
+  // clay_pull has a sphere but no [models.voxel] section; the voxel builder's message names the
+  // scene file by the absolute path the study resolved. The table is published
+  // (docs/results.md): the note names it relative to the working directory, or by its file name
+  // when the scene lies outside it (here: ctest runs in the build tree, the scene in the source).
+  const StudySpec spec =
+      read_study(write_study("abs.toml", "[study]\nname = \"abs\"\nscenes = [\"clay_pull\"]\nmodels = [\"voxel\"]\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_abs_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const StudyResult r = run_study(spec, out, {});
+  ASSERT_EQ(r.rows.size(), 1u);
+  const std::string& note = r.rows[0].note;
+  ASSERT_EQ(note.rfind("not run: ", 0), 0u) << note;
+  EXPECT_NE(note.find("[models.voxel]"), std::string::npos) << note;
+  EXPECT_EQ(note.find(spec.scenes.front().string()), std::string::npos) << note;
+  const fs::path shown = fs::relative(spec.scenes.front(), fs::current_path());
+  const std::string expected = *shown.begin() == ".." ? spec.scenes.front().filename().string() : shown.string();
+  EXPECT_NE(note.find(" in " + expected), std::string::npos) << note;
+  fs::remove_all(out);
+}
+
 TEST(StudyRunner, CommonTimesKeepOnlyTheSamplesBothRunsHave) {
   // A reference that stopped after t = 2 is compared with a model on t = 0, 1, 2 only.
   ForceProfile model, reference;
