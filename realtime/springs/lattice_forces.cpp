@@ -480,6 +480,30 @@ void LatticeForces::gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v)
   }
 }
 
+void LatticeForces::gather_double(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
+  const int P = m_points;
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) {
+      const auto e = static_cast<std::size_t>(r * P + s);
+      m_x[e] = x(r, p);
+      m_v[e] = v(r, p);
+    }
+  }
+}
+
+void LatticeForces::gather_single(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
+  const int P = m_points;
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) {
+      const auto e = static_cast<std::size_t>(r * P + s);
+      m_u_single[e] = static_cast<float>(x(r, p) - m_rest[e]);
+      m_v_single[e] = static_cast<float>(v(r, p));
+    }
+  }
+}
+
 void LatticeForces::place(int node, const Eigen::Vector3d& x, const Eigen::Vector3d& v) noexcept {
   const int s = m_slot[static_cast<std::size_t>(node)];
   for (int r = 0; r < 3; ++r) {
@@ -555,8 +579,11 @@ double LatticeForces::lattice_forces_single(const SpringNetwork& net) noexcept {
 double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                                Eigen::Matrix3Xd& f, ForcePrecision precision) noexcept {
   if (!applies(net)) return network_forces(net, x, v, f);
-  gather(x, v);
   const bool single = precision == ForcePrecision::single_precision;
+  if (single)
+    gather_single(x, v);
+  else
+    gather_double(x, v);
   const double energy = single ? lattice_forces_single(net) : lattice_forces(net);
   const int P = m_points;
   for (int p = 0; p < m_node_count; ++p) {
@@ -565,6 +592,11 @@ double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd&
       f(r, p) = single ? static_cast<double>(m_f_single[static_cast<std::size_t>(r * P + s)]) : m_f[static_cast<std::size_t>(r * P + s)];
   }
   return energy;
+}
+
+double LatticeForces::evaluate_on_lattice(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
+  gather_single(x, v);
+  return lattice_forces_single(net);
 }
 
 double LatticeForces::gershgorin_bound(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept {

@@ -40,6 +40,21 @@ public:
   double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& f,
                   ForcePrecision precision = ForcePrecision::double_precision) noexcept;
 
+  /// The internal forces at positions x and velocities v (3 x capacity) as `evaluate` computes
+  /// them with ForcePrecision::single_precision, left on the lattice instead of written per
+  /// node: `single_forces()` holds them, node n's axis i at entry `lattice_entry(n, i)` (for a
+  /// caller that reads only some of them, or wants them in single precision: the linearly
+  /// implicit step's right-hand side). Loads only the single-precision copies of the state.
+  /// Only while `applies(net)`. Returns the elastic energy [J]. Allocation-free.
+  double evaluate_on_lattice(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
+  /// Entry of node `node`'s axis `axis` (0, 1, 2) in `single_forces()` (axis planes of the
+  /// lattice's points). Only while `applies(net)`.
+  [[nodiscard]] int lattice_entry(int node, int axis) const noexcept {
+    return axis * m_points + m_slot[static_cast<std::size_t>(node)];
+  }
+  /// The forces of the last `evaluate_on_lattice` [N], 3 x points (x, y, z planes).
+  [[nodiscard]] const float* single_forces() const noexcept { return m_f_single.data(); }
+
   /// Symplectic Euler kept on the lattice between sub-steps (the arithmetic of
   /// symplectic_euler_step, without gathering and scattering the state at every sub-step):
   /// `gather` loads x and v (3 x capacity), `place` overwrites one node's position [m] and
@@ -66,6 +81,10 @@ public:
   double gershgorin_bound(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept;
 
 private:
+  /// `gather`'s double-precision positions and velocities alone, and its single-precision
+  /// displacements and velocities alone (what the forces of each precision read).
+  void gather_double(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
+  void gather_single(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
   /// Forces of the gathered state into the lattice force planes; returns the elastic energy.
   double lattice_forces(const SpringNetwork& net) noexcept;
   /// The same in single precision, from the single-precision copies into m_f_single.
