@@ -102,14 +102,14 @@ private:
   std::vector<double> m_cell;          ///< points: 1 where a cell starts, else 0
   std::vector<double> m_x, m_v, m_f;   ///< 3 x points each (x, y, z planes)
   std::vector<double> m_g;             ///< 3 x points: one direction's spring forces
-  std::vector<double> m_q;             ///< 9 x (pad + points): per cell P cof(F)/(4h), columns 0..2
+  std::vector<double> m_q;             ///< 12 x (pad + points): per cell the volume forces on corners 0..3 [N]
   std::vector<double> m_inverse_mass;  ///< 3 x points: 1/m on a node's free axes, else 0 [1/kg]
   std::vector<double> m_free;          ///< 3 x points: 1 on a node's free axes, else 0
   std::vector<double> m_bound_weight;  ///< points: 1/m of a node not fixed on all axes, else 0 [1/kg]
   std::vector<double> m_row;           ///< points: Gershgorin row sums [N/m]
   std::vector<double> m_rest;          ///< 3 x points: the lattice points' rest positions [m]
   /// ForcePrecision::single_precision: u = x − X [m], v, f, one direction's forces, the cells'
-  /// P cof(F)/(4h), the spring constants and the cell mask, in single precision.
+  /// corner forces, the spring constants and the cell mask, in single precision.
   std::vector<float> m_u_single, m_v_single, m_f_single, m_g_single, m_q_single, m_k_single, m_cell_single;
 };
 
