@@ -1,5 +1,6 @@
 // Cost of the spring network (paper 000 §2): one servo sample against N (N^3 cells) for each
-// integrator at 1 kHz (clay, and at 8^3 the peer setting) and at 10 kHz — explicit (its
+// integrator at 1 kHz (clay, and at 8^3 the peer setting for the explicit, implicit and
+// linearly implicit integrators) and at 10 kHz — explicit (its
 // force loops in single precision; `explicit_double` in double), implicit (converged Newton),
 // linear_implicit (one solve per sample) and static; the pieces of a
 // sample (one force evaluation: the spring loop against the lattice loops; one pair of triangular
@@ -250,6 +251,7 @@ BENCHMARK_CAPTURE(step_cost, implicit_10kHz, SpringIntegrator::implicit_euler, c
 BENCHMARK_CAPTURE(step_cost, linear_implicit_10kHz, SpringIntegrator::linearly_implicit_euler, clay, 1e-4)->DenseRange(4, 8, 2)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, explicit_peer, SpringIntegrator::symplectic_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(step_cost, implicit_peer, SpringIntegrator::implicit_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(step_cost, linear_implicit_peer, SpringIntegrator::linearly_implicit_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(system_cost, solve, false, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);

@@ -61,6 +61,35 @@ double direction_springs(int begin, int end, int o, double rest, double tau, dou
   return energy;
 }
 
+/// direction_springs with the end points' share taken in the same loop (F[p + o] −= the
+/// force), for directions whose offset |o| is at least the widest SIMD width in double
+/// precision (8 lanes): then no two lanes of one vector touch the same point, and `safelen(8)`
+/// lets the loop vectorise although F is read and written at p and at p + o (every direction
+/// but the lattice's x edges once a row has 8 points or more). Returns the elastic energy [J].
+KERF_VECTOR_CLONES
+double direction_springs_fused(int begin, int end, int o, double rest, double tau, double tiny, const double* __restrict k,
+                               const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
+                               const double* __restrict VX, const double* __restrict VY, const double* __restrict VZ, double* FX,
+                               double* FY, double* FZ) {
+  double energy = 0.0;
+#pragma omp simd reduction(+ : energy) safelen(8)
+  for (int p = begin; p < end; ++p) {
+    const int q = p + o;
+    const double ex = X[q] - X[p], ey = Y[q] - Y[p], ez = Z[q] - Z[p];
+    const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double inv_l = l > tiny ? 1.0 / l : 0.0; // coincident ends: no direction, no force
+    const double stretch = l - rest;
+    const double rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
+    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
+    const double scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
+    const double gx = scale * ex, gy = scale * ey, gz = scale * ez;
+    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
+    FX[q] -= gx, FY[q] -= gy, FZ[q] -= gz;
+    energy += inv_l > 0.0 ? 0.5 * k[p] * stretch * stretch : 0.0;
+  }
+  return energy;
+}
+
 /// F[p + o] −= G[p] for p in [begin, end): the end points' share of one direction's springs.
 template <class Real>
 [[gnu::always_inline]] inline void direction_ends_of(int begin, int end, int o, const Real* __restrict GX, const Real* __restrict GY,
@@ -149,6 +178,24 @@ float direction_springs_single_fused(int begin, int end, int o, float ox, float 
   return energy;
 }
 
+/// The volume forces on corners 0..3 of one cell, f_a = −P c cof(F) s_a (s_a the corner signs,
+/// s_0 = (−,−,−), s_1 = (+,−,−), s_2 = (−,+,−), s_3 = (+,+,−)), into 12 planes of `stride`
+/// entries (plane 3 a + r: corner a, row r), at W; corner 7 − a takes −f_a (s_{7−a} = −s_a):
+///   f_0 = pc (c_0 + c_1 + c_2),  f_1 = pc (c_2 + c_1 − c_0),  f_2 = pc (c_2 − c_1 + c_0),
+///   f_3 = pc (c_2 − c_1 − c_0),   with pc = P c and c_i column i of cof(F).
+template <class Real>
+[[gnu::always_inline]] inline void corner_forces(Real pc, Real c0x, Real c0y, Real c0z, Real c1x, Real c1y, Real c1z, Real c2x,
+                                                 Real c2y, Real c2z, Real* __restrict W, int stride) {
+  const Real c0[3] = {c0x, c0y, c0z}, c1[3] = {c1x, c1y, c1z}, c2[3] = {c2x, c2y, c2z};
+  for (int r = 0; r < 3; ++r) {
+    const Real sum = c0[r] + c1[r], difference = c0[r] - c1[r];
+    W[r * stride] = pc * (c2[r] + sum);
+    W[(3 + r) * stride] = pc * (c2[r] - difference);
+    W[(6 + r) * stride] = pc * (c2[r] + difference);
+    W[(9 + r) * stride] = pc * (c2[r] - sum);
+  }
+}
+
 /// cell_volumes in single precision on displacements U = x − X: F = I + G with G = c Σ_a u_a ⊗ s_a,
 /// and J − 1 = det(I + G) − 1 = tr G + I₂(G) + det G (I₂ the second invariant), without the
 /// cancellation of det F − 1 in single precision.
@@ -188,10 +235,7 @@ float cell_volumes_single(int end, const int* corner, float c, float kappa_v0, f
                          c1x * column(VX, p, 1) + c1y * column(VY, p, 1) + c1z * column(VZ, p, 1) +
                          c2x * column(VX, p, 2) + c2y * column(VY, p, 2) + c2z * column(VZ, p, 2);
     const float pc = mask[p] * kappa_v0 * (j_minus_1 + tau * J_rate) * c;
-    const int at = pad + p;
-    Q[at] = pc * c0x, Q[stride + at] = pc * c0y, Q[2 * stride + at] = pc * c0z;
-    Q[3 * stride + at] = pc * c1x, Q[4 * stride + at] = pc * c1y, Q[5 * stride + at] = pc * c1z;
-    Q[6 * stride + at] = pc * c2x, Q[7 * stride + at] = pc * c2y, Q[8 * stride + at] = pc * c2z;
+    corner_forces(pc, c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z, Q + pad + p, stride);
     energy += 0.5f * kappa_v0 * mask[p] * j_minus_1 * j_minus_1;
   }
   return energy;
@@ -200,9 +244,9 @@ float cell_volumes_single(int end, const int* corner, float c, float kappa_v0, f
 /// The volume term of the cells starting at lattice points [0, end) (mask 1 where a cell
 /// exists): with c = 1/(4h) and the corner offsets o_a,
 ///   F = c Σ_a x_a ⊗ s_a,  Ḟ = c Σ_a v_a ⊗ s_a,  J = det F,  J̇ = Σ_i cof(F)_i · Ḟ_i,
-///   P = κ V₀ ((J − 1) + τ J̇),  Q_i = P c cof(F)_i (column i of the cofactor),
-/// so that the force on corner a is −Σ_i s_a[i] Q_i (f_a = −P cof(F) g_a, g_a = c s_a).
-/// Q is 9 planes (column i, row r at plane 3 i + r) of `stride` entries, written at pad + p.
+///   P = κ V₀ ((J − 1) + τ J̇),  f_a = −P cof(F) g_a  (g_a = c s_a, s_a the corner signs),
+/// the forces on corners 0..3 written to Q (corner_forces: 12 planes of `stride` entries, at
+/// pad + p; corner 7 − a takes −f_a).
 /// Returns the cells' energy Σ ½ κ V₀ (J − 1)² [J].
 KERF_VECTOR_CLONES
 double cell_volumes(int end, const int* corner, double c, double kappa_v0, double tau, const double* __restrict mask,
@@ -227,36 +271,31 @@ double cell_volumes(int end, const int* corner, double c, double kappa_v0, doubl
                           c2x * cell.column(VX, p, 2) + c2y * cell.column(VY, p, 2) + c2z * cell.column(VZ, p, 2);
     // P c = κ V₀ ((J − 1) + τ J̇) c, masked to the cells that exist
     const double pc = mask[p] * kappa_v0 * ((J - 1.0) + tau * J_rate) * c;
-    const int at = pad + p;
-    Q[at] = pc * c0x, Q[stride + at] = pc * c0y, Q[2 * stride + at] = pc * c0z;
-    Q[3 * stride + at] = pc * c1x, Q[4 * stride + at] = pc * c1y, Q[5 * stride + at] = pc * c1z;
-    Q[6 * stride + at] = pc * c2x, Q[7 * stride + at] = pc * c2y, Q[8 * stride + at] = pc * c2z;
+    corner_forces(pc, c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z, Q + pad + p, stride);
     energy += 0.5 * kappa_v0 * mask[p] * (J - 1.0) * (J - 1.0);
   }
   return energy;
 }
 
-/// F_r[q] −= Σ_a Σ_i s_a[i] Q_{i r}[pad + q − o_a] for lattice points q in [0, points): each
-/// point collects the volume forces of the (up to 8) cells it is a corner of, in one pass per
-/// row r (24 reads, one update of F_r per point).
+/// F_r[q] += Σ_a f_{a,r}[q − o_a] for lattice points q in [0, points), with the corner forces
+/// of corner_forces (planes W_a = Q + 3 a stride + pad, f_{7−a} = −f_a): each point collects
+/// the volume forces of the (up to 8) cells it is a corner of, in one pass per row r (8 reads,
+/// one update of F_r per point).
 template <class Real>
 [[gnu::always_inline]] inline void cell_volume_forces_of(int points, const int* corner, const Real* __restrict Q, int stride, int pad,
                                                          Real* __restrict FX, Real* __restrict FY, Real* __restrict FZ) {
   Real* F[3] = {FX, FY, FZ};
   const int o1 = corner[1], o2 = corner[2], o3 = corner[3], o4 = corner[4], o5 = corner[5], o6 = corner[6], o7 = corner[7];
   for (int r = 0; r < 3; ++r) {
-    const Real* __restrict A = Q + r * stride + pad;       // Q_0r: the s_a[0] column
-    const Real* __restrict B = Q + (3 + r) * stride + pad; // Q_1r
-    const Real* __restrict C = Q + (6 + r) * stride + pad; // Q_2r
+    const Real* __restrict W0 = Q + r * stride + pad;
+    const Real* __restrict W1 = Q + (3 + r) * stride + pad;
+    const Real* __restrict W2 = Q + (6 + r) * stride + pad;
+    const Real* __restrict W3 = Q + (9 + r) * stride + pad;
     Real* __restrict Fr = F[r];
 #pragma omp simd
-    for (int q = 0; q < points; ++q) {
-      // Σ_a (s_a[0] A + s_a[1] B + s_a[2] C)[q − o_a], corner a = bx + 2 by + 4 bz, s = 2b − 1
-      const Real a = (A[q - o1] - A[q]) + (A[q - o3] - A[q - o2]) + (A[q - o5] - A[q - o4]) + (A[q - o7] - A[q - o6]);
-      const Real b = (B[q - o2] - B[q]) + (B[q - o3] - B[q - o1]) + (B[q - o6] - B[q - o4]) + (B[q - o7] - B[q - o5]);
-      const Real c = (C[q - o4] - C[q]) + (C[q - o5] - C[q - o1]) + (C[q - o6] - C[q - o2]) + (C[q - o7] - C[q - o3]);
-      Fr[q] -= a + b + c;
-    }
+    for (int q = 0; q < points; ++q)
+      // corner a of the cell at q − o_a; corners 4..7 take −f_3, −f_2, −f_1, −f_0
+      Fr[q] += ((W0[q] + W1[q - o1]) + (W2[q - o2] + W3[q - o3])) - ((W3[q - o4] + W2[q - o5]) + (W1[q - o6] + W0[q - o7]));
   }
 }
 KERF_VECTOR_CLONES
@@ -425,7 +464,7 @@ LatticeForces::LatticeForces(const SpringNetwork& net) {
   m_v.assign(3 * static_cast<std::size_t>(m_points), 0.0);
   m_f.assign(3 * static_cast<std::size_t>(m_points), 0.0);
   m_g.assign(3 * static_cast<std::size_t>(m_points), 0.0);
-  m_q.assign(9 * static_cast<std::size_t>(m_pad + m_points), 0.0);
+  m_q.assign(12 * static_cast<std::size_t>(m_pad + m_points), 0.0);
   m_inverse_mass.assign(3 * static_cast<std::size_t>(m_points), 0.0);
   m_free.assign(3 * static_cast<std::size_t>(m_points), 0.0);
   m_bound_weight.assign(static_cast<std::size_t>(m_points), 0.0);
@@ -435,7 +474,7 @@ LatticeForces::LatticeForces(const SpringNetwork& net) {
   m_v_single.assign(3 * static_cast<std::size_t>(m_points), 0.0f);
   m_f_single.assign(3 * static_cast<std::size_t>(m_points), 0.0f);
   m_g_single.assign(3 * static_cast<std::size_t>(m_points), 0.0f);
-  m_q_single.assign(9 * static_cast<std::size_t>(m_pad + m_points), 0.0f);
+  m_q_single.assign(12 * static_cast<std::size_t>(m_pad + m_points), 0.0f);
   m_k_single.resize(m_k.size());
   for (std::size_t e = 0; e < m_k.size(); ++e) m_k_single[e] = static_cast<float>(m_k[e]);
   m_cell_single.resize(m_cell.size());
@@ -474,6 +513,30 @@ void LatticeForces::gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v)
       const auto e = static_cast<std::size_t>(r * P + s);
       m_x[e] = x(r, p);
       m_v[e] = v(r, p);
+      m_u_single[e] = static_cast<float>(x(r, p) - m_rest[e]);
+      m_v_single[e] = static_cast<float>(v(r, p));
+    }
+  }
+}
+
+void LatticeForces::gather_double(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
+  const int P = m_points;
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) {
+      const auto e = static_cast<std::size_t>(r * P + s);
+      m_x[e] = x(r, p);
+      m_v[e] = v(r, p);
+    }
+  }
+}
+
+void LatticeForces::gather_single(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
+  const int P = m_points;
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) {
+      const auto e = static_cast<std::size_t>(r * P + s);
       m_u_single[e] = static_cast<float>(x(r, p) - m_rest[e]);
       m_v_single[e] = static_cast<float>(v(r, p));
     }
@@ -555,8 +618,11 @@ double LatticeForces::lattice_forces_single(const SpringNetwork& net) noexcept {
 double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                                Eigen::Matrix3Xd& f, ForcePrecision precision) noexcept {
   if (!applies(net)) return network_forces(net, x, v, f);
-  gather(x, v);
   const bool single = precision == ForcePrecision::single_precision;
+  if (single)
+    gather_single(x, v);
+  else
+    gather_double(x, v);
   const double energy = single ? lattice_forces_single(net) : lattice_forces(net);
   const int P = m_points;
   for (int p = 0; p < m_node_count; ++p) {
@@ -565,6 +631,11 @@ double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd&
       f(r, p) = single ? static_cast<double>(m_f_single[static_cast<std::size_t>(r * P + s)]) : m_f[static_cast<std::size_t>(r * P + s)];
   }
   return energy;
+}
+
+double LatticeForces::evaluate_on_lattice(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
+  gather_single(x, v);
+  return lattice_forces_single(net);
 }
 
 double LatticeForces::gershgorin_bound(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept {
@@ -609,6 +680,12 @@ double LatticeForces::lattice_forces(const SpringNetwork& net) noexcept {
   for (std::size_t d = 0; d < directions.size(); ++d) {
     const int o = m_offset[d];
     const int begin = std::max(0, -o), end = P - std::max(0, o);
+    if (std::abs(o) >= 8) { // the end points' share in the same loop
+      energy += direction_springs_fused(begin, end, o, net.rest_length(m_type[d]), tau, tiny,
+                                        m_k.data() + d * static_cast<std::size_t>(P), X, X + P, X + 2 * P, V, V + P, V + 2 * P, F,
+                                        F + P, F + 2 * P);
+      continue;
+    }
     energy += direction_springs(begin, end, o, net.rest_length(m_type[d]), tau, tiny, m_k.data() + d * static_cast<std::size_t>(P),
                                 X, X + P, X + 2 * P, V, V + P, V + 2 * P, F, F + P, F + 2 * P, G, G + P, G + 2 * P);
     direction_ends(begin, end, o, G, G + P, G + 2 * P, F, F + P, F + 2 * P);

@@ -40,6 +40,21 @@ public:
   double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& f,
                   ForcePrecision precision = ForcePrecision::double_precision) noexcept;
 
+  /// The internal forces at positions x and velocities v (3 x capacity) as `evaluate` computes
+  /// them with ForcePrecision::single_precision, left on the lattice instead of written per
+  /// node: `single_forces()` holds them, node n's axis i at entry `lattice_entry(n, i)` (for a
+  /// caller that reads only some of them, or wants them in single precision: the linearly
+  /// implicit step's right-hand side). Loads only the single-precision copies of the state.
+  /// Only while `applies(net)`. Returns the elastic energy [J]. Allocation-free.
+  double evaluate_on_lattice(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
+  /// Entry of node `node`'s axis `axis` (0, 1, 2) in `single_forces()` (axis planes of the
+  /// lattice's points). Only while `applies(net)`.
+  [[nodiscard]] int lattice_entry(int node, int axis) const noexcept {
+    return axis * m_points + m_slot[static_cast<std::size_t>(node)];
+  }
+  /// The forces of the last `evaluate_on_lattice` [N], 3 x points (x, y, z planes).
+  [[nodiscard]] const float* single_forces() const noexcept { return m_f_single.data(); }
+
   /// Symplectic Euler kept on the lattice between sub-steps (the arithmetic of
   /// symplectic_euler_step, without gathering and scattering the state at every sub-step):
   /// `gather` loads x and v (3 x capacity), `place` overwrites one node's position [m] and
@@ -66,6 +81,10 @@ public:
   double gershgorin_bound(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept;
 
 private:
+  /// `gather`'s double-precision positions and velocities alone, and its single-precision
+  /// displacements and velocities alone (what the forces of each precision read).
+  void gather_double(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
+  void gather_single(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
   /// Forces of the gathered state into the lattice force planes; returns the elastic energy.
   double lattice_forces(const SpringNetwork& net) noexcept;
   /// The same in single precision, from the single-precision copies into m_f_single.
@@ -83,14 +102,14 @@ private:
   std::vector<double> m_cell;          ///< points: 1 where a cell starts, else 0
   std::vector<double> m_x, m_v, m_f;   ///< 3 x points each (x, y, z planes)
   std::vector<double> m_g;             ///< 3 x points: one direction's spring forces
-  std::vector<double> m_q;             ///< 9 x (pad + points): per cell P cof(F)/(4h), columns 0..2
+  std::vector<double> m_q;             ///< 12 x (pad + points): per cell the volume forces on corners 0..3 [N]
   std::vector<double> m_inverse_mass;  ///< 3 x points: 1/m on a node's free axes, else 0 [1/kg]
   std::vector<double> m_free;          ///< 3 x points: 1 on a node's free axes, else 0
   std::vector<double> m_bound_weight;  ///< points: 1/m of a node not fixed on all axes, else 0 [1/kg]
   std::vector<double> m_row;           ///< points: Gershgorin row sums [N/m]
   std::vector<double> m_rest;          ///< 3 x points: the lattice points' rest positions [m]
   /// ForcePrecision::single_precision: u = x − X [m], v, f, one direction's forces, the cells'
-  /// P cof(F)/(4h), the spring constants and the cell mask, in single precision.
+  /// corner forces, the spring constants and the cell mask, in single precision.
   std::vector<float> m_u_single, m_v_single, m_f_single, m_g_single, m_q_single, m_k_single, m_cell_single;
 };
 

@@ -860,9 +860,16 @@ void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noex
     return;
   }
   for (int k = 0; k < n; ++k) m_solution_single[static_cast<std::size_t>(k)] = static_cast<float>(rhs[k]);
+  solve_in_place();
+  for (int k = 0; k < n; ++k) out[k] = static_cast<double>(m_solution_single[static_cast<std::size_t>(k)]);
+}
+
+bool NetworkSystem::solve_in_place() noexcept {
+  if (m_precision != SolvePrecision::single_precision) return false;
+  if (dof_count() == 0) return true;
   inverse_block_solve(*m_factor, m_inverse_blocks.data() + m_inverse_align, m_inverse_block_at.data(), m_solution_single.data(),
                       m_rows_single.data(), m_rows_single.data() + m_rows_split);
-  for (int k = 0; k < n; ++k) out[k] = static_cast<double>(m_solution_single[static_cast<std::size_t>(k)]);
+  return true;
 }
 
 } // namespace kerf

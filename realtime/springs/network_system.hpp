@@ -91,6 +91,14 @@ public:
   ///   forward,  y_s ← T_s⁻¹ y_s,  y_b −= R_s y_s;   backward,  x_s ← T_s⁻ᵀ (x_s − R_sᵀ x_b),
   /// each a dense matrix-vector product of independent columns (four per pass).
   void solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept;
+  /// SolvePrecision::single_precision: `solve` without the conversions, on the solve's own
+  /// single-precision vector (dof_count() floats, in the factor's order): fill
+  /// `single_precision_vector()` with the right-hand side, call `solve_in_place`, read A⁻¹ rhs
+  /// from the same vector (for a caller whose right-hand side is in single precision already,
+  /// the linearly implicit step's lattice forces). Allocation-free. False (nothing solved) with
+  /// SolvePrecision::double_precision.
+  [[nodiscard]] float* single_precision_vector() noexcept { return m_solution_single.data(); }
+  bool solve_in_place() noexcept;
 
   /// The assembled matrix (lower triangle stored).
   [[nodiscard]] const Matrix& matrix() const { return m_matrix; }

@@ -1,5 +1,6 @@
 #include "realtime/springs/newton_stepper.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -32,6 +33,7 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_free_entry.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_dof.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_mass.assign(3 * static_cast<std::size_t>(cap), 0.0);
+  m_free_lattice.assign(3 * static_cast<std::size_t>(cap), 0);
   m_r.setZero(m_system.dof_count());
   m_dx.setZero(m_system.dof_count());
   bind_free_entries(net);
@@ -51,6 +53,7 @@ void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
   // Sized for every entry of the capacity (3 x capacity) at rebuild: binding after a split
   // only rewrites them.
   const auto& dof = m_system.dof_of();
+  const bool lattice = m_forces.applies(net);
   m_free_count = 0;
   for (int p = 0; p < net.node_count; ++p)
     for (int i = 0; i < 3; ++i)
@@ -59,6 +62,7 @@ void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
         m_free_entry[k] = 3 * p + i;
         m_free_dof[k] = d;
         m_free_mass[k] = net.mass[static_cast<std::size_t>(p)];
+        m_free_lattice[k] = lattice ? m_forces.lattice_entry(p, i) : -1;
       }
 }
 
@@ -79,10 +83,13 @@ double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd&
   const double* X0 = m_x0.data();
   const double* V0 = m_v0.data();
   double* V = v.data();
+  // Products with 1/h and 1/h² instead of two divisions per entry (a scalar division is about
+  // as costly as the rest of the entry's work).
+  const double inverse_dt = 1.0 / dt, inverse_dt2 = inverse_dt * inverse_dt;
   if (implicit)
     for (int k = 0; k < m_free_count; ++k) {
       const int e = m_free_entry[static_cast<std::size_t>(k)];
-      V[e] = (X[e] - X0[e]) / dt;
+      V[e] = (X[e] - X0[e]) * inverse_dt;
     }
   else
     for (int k = 0; k < m_free_count; ++k) V[m_free_entry[static_cast<std::size_t>(k)]] = 0.0;
@@ -94,15 +101,88 @@ double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd&
     const int e = m_free_entry[static_cast<std::size_t>(k)];
     // implicit: r = M (x − xₙ − h vₙ)/h² − f;  quasi-static: r = −f
     double r = -F[e];
-    if (implicit) r += m_free_mass[static_cast<std::size_t>(k)] * (X[e] - X0[e] - dt * V0[e]) / (dt * dt);
+    if (implicit) r += m_free_mass[static_cast<std::size_t>(k)] * (X[e] - X0[e] - dt * V0[e]) * inverse_dt2;
     m_r[m_free_dof[static_cast<std::size_t>(k)]] = r;
     norm = std::max(norm, std::abs(r));
   }
   return norm;
 }
 
+NewtonReport NewtonStepper::advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
+                                                          double dt) noexcept {
+  NewtonReport report;
+  double* X = x.data();
+  double* V = v.data();
+  double* X0 = m_x0.data();
+  double* V0 = m_v0.data();
+  const int* entry = m_free_entry.data();
+  const int* dof = m_free_dof.data();
+  const int* lattice = m_free_lattice.data();
+  // The predictor x* = xₙ + h vₙ on the free entries (xₙ, vₙ kept for the check's residual).
+  for (int k = 0; k < m_free_count; ++k) {
+    const int e = entry[k];
+    X0[e] = X[e];
+    V0[e] = V[e];
+    X[e] += dt * V[e];
+  }
+  bool fresh = false;
+  if (m_factor_dt != dt) {
+    if (!refactor(net, x, dt)) {
+      report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
+      return report;
+    }
+    ++report.factorisations;
+    fresh = true;
+  }
+  // r(x*) = M (x* − xₙ − h vₙ)/h² − f(x*, v*) = −f(x*, vₙ): v* = (x* − xₙ)/h = vₙ on the free
+  // entries (the fixed ones hold their prescribed velocities), and the inertia term vanishes.
+  // The forces in single precision on the lattice, straight into the solve's vector.
+  m_forces.evaluate_on_lattice(net, x, v);
+  const float* F = m_forces.single_forces();
+  float* b = m_system.single_precision_vector();
+  float largest = 0.0f;
+  for (int k = 0; k < m_free_count; ++k) {
+    const float f = F[lattice[k]];
+    b[dof[k]] = f;
+    largest = std::max(largest, std::abs(f));
+  }
+  const double norm = largest;
+  // A kept factorisation that a check found stale is refreshed at this predictor (see advance).
+  if (m_refresh_pending && !fresh) {
+    if (!refactor(net, x, dt)) {
+      // A not positive definite at x*: no step this sample (the state stays at the predictor,
+      // v = vₙ, reported unconverged), the refresh is tried again at the next.
+      report.residual = norm;
+      return report;
+    }
+    ++report.factorisations;
+  }
+  m_refresh_pending = false;
+  // A y = f(x*) = −r(x*):  x = x* + y,  v = (x − xₙ)/h = vₙ + y/h.
+  m_system.solve_in_place();
+  const double inverse_dt = 1.0 / dt;
+  bool finite = true;
+  for (int k = 0; k < m_free_count; ++k) {
+    const int e = entry[k];
+    const double y = b[dof[k]];
+    X[e] += y;
+    V[e] += y * inverse_dt;
+    finite = finite && std::isfinite(X[e]) && std::isfinite(V[e]);
+  }
+  report.iterations = 1;
+  report.residual = norm;
+  if (++m_calls_since_check >= linearised_check_interval) {
+    m_calls_since_check = 0;
+    report.residual = residual(net, x, v, dt); // also sets v = (x − xₙ)/h
+    m_refresh_pending = report.residual > m_tolerance_ratio * net.stiffness.edge * net.block.cell_size && report.residual > 0.25 * norm;
+  }
+  report.converged = finite;
+  return report;
+}
+
 NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
                                     double dt) noexcept {
+  if (m_mode == Mode::linearly_implicit_euler && m_forces.applies(net)) return advance_linearised_on_lattice(net, x, v, dt);
   NewtonReport report;
   const int n = net.node_count;
   m_x0.leftCols(n) = x.leftCols(n);
@@ -143,7 +223,7 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
         // reported unconverged), the refresh is tried again at the next.
         for (int k = 0; k < m_free_count; ++k) {
           const int e = m_free_entry[static_cast<std::size_t>(k)];
-          v.data()[e] = (x.data()[e] - m_x0.data()[e]) / dt;
+          v.data()[e] = (x.data()[e] - m_x0.data()[e]) * (1.0 / dt);
         }
         report.residual = norm;
         return report;
@@ -166,7 +246,7 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
     } else {
       for (int k = 0; k < m_free_count; ++k) {
         const int e = m_free_entry[static_cast<std::size_t>(k)];
-        v.data()[e] = (x.data()[e] - m_x0.data()[e]) / dt;
+        v.data()[e] = (x.data()[e] - m_x0.data()[e]) * (1.0 / dt);
       }
     }
     report.converged = x.leftCols(n).allFinite();

@@ -44,9 +44,13 @@ public:
     /// residual after the step, and a step that reduced it by less than 4 x (modified Newton's
     /// criterion) marks it so; with a stale A a mode grows from sample to sample). One force
     /// evaluation and one pair of triangular solves per call (a second evaluation on check
-    /// calls); otherwise the residual after the step is not evaluated, so `forces()` keeps the
-    /// forces at the predictor and the report is `converged` by definition (its `residual` is
-    /// the predictor's, or after the step on check calls).
+    /// calls); otherwise the residual after the step is not evaluated, and the report is
+    /// `converged` whenever the new state is finite (its `residual` is the predictor's, or after
+    /// the step on check calls). At the predictor the velocity is vₙ, so the inertia term of
+    /// the residual vanishes and r(x*) = −f(x*, vₙ): while the network is untorn the step takes
+    /// f in single precision straight from the lattice into the single-precision solve and back
+    /// (x ← x* + A⁻¹ f, v ← vₙ + A⁻¹ f / h), without the per-node force arrays; `forces()` then
+    /// holds the forces of the last check call (after a tear: those at the predictor).
     linearly_implicit_euler
   };
 
@@ -83,6 +87,8 @@ private:
   bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
   double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
                   LatticeForces::ForcePrecision precision = LatticeForces::ForcePrecision::double_precision) noexcept;
+  /// The linearly implicit step while the network is untorn (see Mode::linearly_implicit_euler).
+  NewtonReport advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
   /// The free entries (3 p + i with a dof) in node order, their dofs and node masses, from the
   /// system's numbering (after rebuild and after binding splits). Allocation-free.
   void bind_free_entries(const SpringNetwork& net) noexcept;
@@ -102,6 +108,7 @@ private:
   int m_free_count = 0;
   std::vector<int> m_free_entry, m_free_dof; ///< per free entry: 3 p + i, and its dof
   std::vector<double> m_free_mass;           ///< per free entry: the node's mass [kg]
+  std::vector<int> m_free_lattice;           ///< per free entry: its LatticeForces::lattice_entry (while untorn)
 };
 
 } // namespace kerf
