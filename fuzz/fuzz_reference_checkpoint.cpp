@@ -30,12 +30,13 @@ void fuzz_reference_checkpoint(std::span<const std::byte> data) {
     // What EnergyBookkeeping::from_json (reference_fracture.cpp) reads on resume, field by field
     // (that file brings the reference's headers, which this parser-only build leaves out): an
     // accepted record must give every field without a json exception, the kinetic energy and the
-    // trapezoid work of a dynamic run included.
+    // trapezoid work and the damping dissipation of a dynamic run included.
     const nlohmann::json& e = c.samples.back().at("energy");
     for (const char* key : {"external_work_J", "stored_elastic_energy_J", "interface_energy_J", "cohesive_dissipation_J",
                             "viscous_dissipation_J", "failed_area_m2"})
       (void)e.at(key).get<double>();
-    for (const char* key : {"contact_energy_J", "kinetic_energy_J", "cohesive_trapezoid_work_J"}) (void)e.value(key, 0.0);
+    for (const char* key : {"contact_energy_J", "kinetic_energy_J", "cohesive_trapezoid_work_J", "damping_dissipation_J"})
+      (void)e.value(key, 0.0);
     for (const char* key : {"last_positions_m", "last_forces_on_body_N"})
       for (const auto& v : e.at(key)) (void)Eigen::Vector3d(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
   }

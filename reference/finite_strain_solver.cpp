@@ -12,6 +12,7 @@
 #include "reference/contact/blade_edge_contact.hpp"
 #include "reference/material/decoupled_neo_hookean.hpp"
 #include "reference/material/finite_strain_error.hpp"
+#include "reference/material/kelvin_voigt.hpp"
 #include "reference/material/neo_hookean.hpp"
 #include "reference/material/st_venant_kirchhoff.hpp"
 #include "reference/mpi_processes.hpp"
@@ -155,6 +156,7 @@ struct FiniteStrainSolver::Impl {
   std::vector<std::unique_ptr<HyperelasticLaw>> laws; // by material_id
   std::vector<double> youngs; // by material_id
   std::vector<double> densities; // by material_id [kg/m^3]
+  std::vector<KelvinVoigtDamping> damping; // by material_id (dynamic step only)
 
   // Dynamic step (SolverSettings::dynamic; serial only): Newmark average acceleration with the
   // consistent mass. Each cell's scalar mass matrix m_ij = ∫ ρ N_i N_j dV over its scalar shape
@@ -168,6 +170,11 @@ struct FiniteStrainSolver::Impl {
     dealii::Vector<double> u, v, a;             // u_n, v_n, a_n (all DOFs, global order)
     double step = 0.0;                          // h [s] of the current solve
     double kinetic_energy = 0.0;                // ½ v_nᵀ M v_n [J]
+    // Kelvin–Voigt damping (some region's retardation time > 0): the viscous nodal forces
+    // f_v(u_n, v_n) of the committed state and the dissipation Σ ½ (f_v,n + f_v,n+1)·Δu so far.
+    bool damped = false;
+    dealii::Vector<double> viscous_force;
+    double damping_dissipation = 0.0;           // [J]
   };
   std::optional<Dynamics> dynamics;
   void build_dynamics();
@@ -176,8 +183,18 @@ struct FiniteStrainSolver::Impl {
     const Dynamics& d = *dynamics;
     return 4.0 / (d.step * d.step) * (u - d.u[i]) - 4.0 / d.step * d.v[i] - d.a[i];
   }
-  /// Commits u_{n+1} (`u`): a_{n+1}, v_{n+1} = v_n + h/2 (a_n + a_{n+1}); returns ½ vᵀ M v.
+  /// v_{n+1} at DOF i for the trial displacement u_i (γ = 1/2, β = 1/4: 2/h (u − u_n) − v_n).
+  [[nodiscard]] double newmark_velocity(dealii::types::global_dof_index i, double u) const {
+    const Dynamics& d = *dynamics;
+    return 2.0 / d.step * (u - d.u[i]) - d.v[i];
+  }
+  /// Commits u_{n+1} (`u`): a_{n+1}, v_{n+1} = v_n + h/2 (a_n + a_{n+1}), and with damping the
+  /// viscous forces at (u_{n+1}, v_{n+1}) and the step's dissipation; returns ½ vᵀ M v.
   double commit_dynamics(const dealii::Vector<double>& u);
+  /// The Kelvin–Voigt nodal forces f_v,a = ∫ P_v(F, Ḟ) : (e_c ⊗ Grad N_a) dV at displacement u and
+  /// velocity v (all DOFs, serial).
+  void assemble_viscous_force(const dealii::Vector<double>& u, const dealii::Vector<double>& v,
+                              dealii::Vector<double>& out) const;
 
   // Dirichlet DOFs and how to get their target value.
   struct DirichletDof {
@@ -344,6 +361,8 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     laws.push_back(make_law(problem.materials[r]));
     youngs.push_back(problem.materials[r].youngs_modulus);
     densities.push_back(problem.materials[r].density);
+    damping.push_back(kelvin_voigt_damping(problem.materials[r].youngs_modulus, problem.materials[r].poisson_ratio,
+                                           problem.materials[r].damping));
   }
   std::vector<dealii::Point<3>> vertices(static_cast<std::size_t>(mesh.nodes.rows()));
   for (Eigen::Index v = 0; v < mesh.nodes.rows(); ++v)
@@ -684,6 +703,7 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
   for (unsigned i = 0; i < n; ++i) comp[i] = fe->system_to_component_index(i).first;
   std::vector<Eigen::Vector3d> gradN(n);
   std::vector<Eigen::Matrix<double, 9, 1>> AgradN(n);
+  std::vector<double> velocity(n);
 
   for (const auto& cell : dof.active_cell_iterators()) {
     if (!cell->is_locally_owned()) continue; // distributed: another process assembles it
@@ -708,6 +728,11 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
           if (with_matrix) cell_K(i, j) += c * Mij;
         }
     }
+    // Kelvin–Voigt damping (dynamic step): the Newmark velocity v_{n+1}(u) of the cell's DOFs.
+    const bool damped = dynamics && dynamics->damped && dynamics->step > 0.0 &&
+                        damping[cell->material_id()].retardation_time > 0.0;
+    if (damped)
+      for (unsigned i = 0; i < n; ++i) velocity[i] = newmark_velocity(local[i], state(local[i]));
     for (unsigned q = 0; q < fv.n_quadrature_points; ++q) {
       // F = I + Grad u (total Lagrangian: gradients with respect to the reference configuration)
       const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(grads[q]);
@@ -715,13 +740,21 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
       Eigen::Matrix3d S;
       Tensor4 C4;
       law.second_piola_and_tangent(F, S, C4);
-      const StressTangent st = first_piola_and_tangent(F, S, C4);
+      StressTangent st = first_piola_and_tangent(F, S, C4);
       for (unsigned i = 0; i < n; ++i) {
         const auto g = fv.shape_grad_component(i, q, comp[i]);
         gradN[i] = Eigen::Vector3d(g[0], g[1], g[2]);
-        // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
-        cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
       }
+      if (damped) {
+        // Ḟ = Grad v = Σ_a v_a e_c ⊗ Grad N_a; P += P_v(F, Ḟ), 𝔸 += ∂P_v/∂F with ∂Ḟ/∂F = γ/(βh) = 2/h.
+        Eigen::Matrix3d F_rate = Eigen::Matrix3d::Zero();
+        for (unsigned i = 0; i < n; ++i) F_rate.row(comp[i]) += velocity[i] * gradN[i].transpose();
+        const StressTangent sv = kelvin_voigt_stress(damping[cell->material_id()], F, F_rate, 2.0 / dynamics->step);
+        st.first_piola += sv.first_piola;
+        if (with_matrix) st.tangent += sv.tangent;
+      }
+      // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
+      for (unsigned i = 0; i < n; ++i) cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
       if (!with_matrix) continue;
       // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV
       for (unsigned j = 0; j < n; ++j) AgradN[j] = st.tangent.middleCols<3>(3 * comp[j]) * gradN[j];
@@ -813,6 +846,8 @@ void FiniteStrainSolver::Impl::build_dynamics() {
   d.u.reinit(dof.n_dofs());
   d.v.reinit(dof.n_dofs());
   d.a.reinit(dof.n_dofs());
+  d.damped = std::any_of(damping.begin(), damping.end(), [](const KelvinVoigtDamping& k) { return k.retardation_time > 0.0; });
+  if (d.damped) d.viscous_force.reinit(dof.n_dofs());
   dynamics = std::move(d);
 }
 
@@ -825,6 +860,16 @@ double FiniteStrainSolver::Impl::commit_dynamics(const dealii::Vector<double>& u
       d.v[i] += 0.5 * d.step * (d.a[i] + a_next);
       d.a[i] = a_next;
     }
+  if (d.damped) {
+    // The viscous forces at (u_{n+1}, v_{n+1}); a step (h > 0) dissipates their trapezoid work
+    // ½ (f_v,n + f_v,n+1)·(u_{n+1} − u_n), the term the Newmark energy identity books for them.
+    dealii::Vector<double> f_next(u.size());
+    assemble_viscous_force(u, d.v, f_next);
+    if (d.step > 0.0)
+      for (dealii::types::global_dof_index i = 0; i < u.size(); ++i)
+        d.damping_dissipation += 0.5 * (d.viscous_force[i] + f_next[i]) * (u[i] - d.u[i]);
+    d.viscous_force = std::move(f_next);
+  }
   d.u = u;
   // ½ vᵀ M v, cell by cell (M_ab = m_ij δ(c_a, c_b)).
   const unsigned n = fe->n_dofs_per_cell();
@@ -840,6 +885,36 @@ double FiniteStrainSolver::Impl::commit_dynamics(const dealii::Vector<double>& u
   }
   d.kinetic_energy = kinetic;
   return kinetic;
+}
+
+void FiniteStrainSolver::Impl::assemble_viscous_force(const dealii::Vector<double>& u, const dealii::Vector<double>& v,
+                                                      dealii::Vector<double>& out) const {
+  out = 0.0;
+  const unsigned n = fe->n_dofs_per_cell();
+  dealii::FEValues<3> fv(*mapping, *fe, *cell_quadrature, dealii::update_gradients | dealii::update_JxW_values);
+  const dealii::FEValuesExtractors::Vector disp(0);
+  std::vector<dealii::Tensor<2, 3>> grads(cell_quadrature->size()), rates(cell_quadrature->size());
+  std::vector<dealii::types::global_dof_index> local(n);
+  dealii::Vector<double> cell_f(n);
+  for (const auto& cell : dof.active_cell_iterators()) {
+    const KelvinVoigtDamping& kv = damping[cell->material_id()];
+    if (kv.retardation_time == 0.0) continue;
+    fv.reinit(cell);
+    cell->get_dof_indices(local);
+    fv[disp].get_function_gradients(u, grads);
+    fv[disp].get_function_gradients(v, rates);
+    cell_f = 0.0;
+    for (unsigned q = 0; q < fv.n_quadrature_points; ++q) {
+      const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(grads[q]);
+      const Eigen::Matrix3d P_v = kelvin_voigt_stress(kv, F, to_eigen(rates[q]), 0.0).first_piola;
+      for (unsigned i = 0; i < n; ++i) {
+        const unsigned c = fe->system_to_component_index(i).first;
+        const auto g = fv.shape_grad_component(i, q, c);
+        cell_f(i) += P_v.row(c).dot(Eigen::Vector3d(g[0], g[1], g[2])) * fv.JxW(q);
+      }
+    }
+    out.add(local, cell_f);
+  }
 }
 
 void FiniteStrainSolver::Impl::build_blade_edge() {
@@ -1133,7 +1208,12 @@ CohesiveSummary FiniteStrainSolver::Impl::commit_cohesive(const LoadState& load)
         const Eigen::Vector3d& n = cohesive_pairs[p].normal;
         const CohesiveResponse before = cohesive_response(*cohesive_law, state, state.previous_opening, n, 0.0);
         const CohesiveResponse after = cohesive_law->viscosity > 0.0 ? cohesive_response(*cohesive_law, state, opening, n, 0.0) : r;
-        cohesive_trapezoid_work += 0.5 * (before.traction + after.traction).dot(opening - state.previous_opening) * w;
+        const double trapezoid = 0.5 * (before.traction + after.traction).dot(opening - state.previous_opening) * w;
+        cohesive_trapezoid_work += trapezoid;
+        // The step's kinks error: the trapezoid work minus Δ(φ_e + φ_d) at this point.
+        summary.step_time_integration_error +=
+            trapezoid - (after.stored_energy + after.dissipated_energy - before.stored_energy - before.dissipated_energy) * w;
+        summary.step_dissipation += (after.dissipated_energy - before.dissipated_energy) * w;
       }
       state.max_opening = r.damage_opening;
       state.previous_opening = opening;
@@ -1269,6 +1349,7 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
   if (m.cohesive_law) report.cohesive = m.commit_cohesive(load);
   if (m.dynamics) {
     if constexpr (std::is_same_v<VectorType, dealii::Vector<double>>) report.kinetic_energy = m.commit_dynamics(la.u);
+    report.damping_dissipation = m.dynamics->damping_dissipation;
   }
   m.committed_time = load.time;
   report.tool_force = -assembly.contact_on_body;
@@ -1311,6 +1392,9 @@ double FiniteStrainSolver::max_displacement() const {
 }
 
 double FiniteStrainSolver::kinetic_energy() const { return m_impl->dynamics ? m_impl->dynamics->kinetic_energy : 0.0; }
+double FiniteStrainSolver::damping_dissipation() const {
+  return m_impl->dynamics ? m_impl->dynamics->damping_dissipation : 0.0;
+}
 
 int FiniteStrainSolver::process_count() const { return m_impl->distributed ? m_impl->process_count : 1; }
 
@@ -1411,6 +1495,7 @@ std::vector<double> FiniteStrainSolver::state() const {
     values.insert(values.end(), m.dynamics->a.begin(), m.dynamics->a.end());
     values.push_back(m.committed_time);
     values.push_back(m.cohesive_trapezoid_work);
+    if (m.dynamics->damped) values.push_back(m.dynamics->damping_dissipation);
   }
   return values;
 }
@@ -1418,13 +1503,15 @@ std::vector<double> FiniteStrainSolver::state() const {
 void FiniteStrainSolver::set_state(const std::vector<double>& values) {
   Impl& m = *m_impl;
   const std::size_t n_dofs = m.dof.n_dofs();
+  const std::size_t damped = m.dynamics && m.dynamics->damped ? 1 : 0;
   const std::size_t expected = n_dofs + (m.cohesive_law ? 4 * m.cohesive_states.size() + 2 : 0) +
-                               (m.dynamics ? 2 * n_dofs + 2 : 0);
+                               (m.dynamics ? 2 * n_dofs + 2 + damped : 0);
   if (values.size() != expected)
     throw std::invalid_argument("set_state: " + std::to_string(values.size()) + " values, expected " + std::to_string(expected) +
                                 " (" + std::to_string(n_dofs) + " DOFs" +
                                 (m.cohesive_law ? " + 4 per cohesive point + 2" : std::string()) +
-                                (m.dynamics ? " + velocity and acceleration per DOF + 2 (dynamic step)" : std::string()) + ")");
+                                (m.dynamics ? " + velocity and acceleration per DOF + 2 (dynamic step)" : std::string()) +
+                                (damped ? " + 1 (Kelvin-Voigt damping)" : "") + ")");
   if (m.cohesive_law) {
     auto it = values.begin() + static_cast<std::ptrdiff_t>(n_dofs);
     for (CohesiveState& s : m.cohesive_states) {
@@ -1437,13 +1524,15 @@ void FiniteStrainSolver::set_state(const std::vector<double>& values) {
   if (!m.distributed) {
     std::copy(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(n_dofs), m.serial.u.begin());
     if (m.dynamics) {
-      auto it = values.end() - static_cast<std::ptrdiff_t>(2 * n_dofs + 2);
+      const auto tail = values.end() - static_cast<std::ptrdiff_t>(damped);
+      auto it = tail - static_cast<std::ptrdiff_t>(2 * n_dofs + 2);
       std::copy(it, it + static_cast<std::ptrdiff_t>(n_dofs), m.dynamics->v.begin());
       std::copy(it + static_cast<std::ptrdiff_t>(n_dofs), it + static_cast<std::ptrdiff_t>(2 * n_dofs), m.dynamics->a.begin());
-      m.committed_time = values.end()[-2];
-      m.cohesive_trapezoid_work = values.back();
+      m.committed_time = tail[-2];
+      m.cohesive_trapezoid_work = tail[-1];
+      if (damped) m.dynamics->damping_dissipation = values.back();
       m.dynamics->step = 0.0;
-      (void)m.commit_dynamics(m.serial.u); // u_n = u; the kinetic energy of the restored v
+      (void)m.commit_dynamics(m.serial.u); // u_n = u; the kinetic energy and viscous forces of the restored v
     }
     return;
   }

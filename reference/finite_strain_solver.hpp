@@ -48,6 +48,11 @@ struct MaterialRegion {
   /// ρ [kg/m^3] in the reference configuration: the consistent mass of the dynamic step
   /// (SolverSettings::dynamic; must then be > 0), unused by the quasi-static solve.
   double density = 0.0;
+  /// Kelvin–Voigt viscosity η [Pa s] >= 0 (the scene's `damping`): with SolverSettings::dynamic a
+  /// viscous stress S_v = (η/E) ℂ₀ : Ė on the Green–Lagrange strain rate joins the elastic one
+  /// (reference/material/kelvin_voigt.hpp; every mode's damping ratio ζ = ωη/(2E)); the
+  /// quasi-static solve has no rate and ignores it.
+  double damping = 0.0;
 };
 
 /// A displacement condition on a named TetMesh surface group.
@@ -147,6 +152,8 @@ struct SolverSettings {
   /// first sample) is quasi-static and leaves v and a unchanged; the body starts at rest (v = a = 0).
   /// Reactions (and the tool forces of tied styluses) include the inertia of the driven nodes.
   /// Serial only (a distributed mesh is refused). Every material region needs a density > 0.
+  /// A region's `damping` η > 0 adds the Kelvin–Voigt viscous stress (MaterialRegion::damping), its
+  /// velocity v_{n+1} = 2/h (u_{n+1} − u_n) − v_n (γ/(βh) = 2/h in Newton's tangent).
   bool dynamic = false;
 };
 
@@ -166,6 +173,13 @@ struct CohesiveSummary {
   /// ligament that opens past δ_f in one step), the difference is the time integration's error
   /// at the kink, which shrinks with the time step.
   double trapezoid_work = 0.0;
+  /// Dynamic step only: this step's share of the kinks' error, the trapezoid work of the interface
+  /// tractions over the step minus the step's change of stored_energy + dissipated_energy [J]
+  ///   e = Σ_points w [½ (t_n + t_{n+1})·(Δ_{n+1} − Δ_n) − Δ(φ_e + φ_d)],
+  /// zero when every point stays on one linear piece of the law within the step. The load path's
+  /// interface energy control (LoadPathSettings) rejects and halves a step whose |e| is too large.
+  double step_time_integration_error = 0.0;
+  double step_dissipation = 0.0; ///< dynamic step only: the step's increase of dissipated_energy [J]
   double max_damage = 0.0;         ///< largest 1 − K(κ)/K_0 over the points
 };
 
@@ -202,6 +216,10 @@ struct EquilibriumReport {
   double contact_energy = 0.0;
   /// Kinetic energy ½ vᵀ M v [J] after this solve (0 for the quasi-static step).
   double kinetic_energy = 0.0;
+  /// Energy dissipated by the Kelvin–Voigt damping so far [J] (dynamic step with a region's
+  /// `damping` > 0, else 0): Σ_steps ½ (f_v,n + f_v,n+1)·(u_{n+1} − u_n) over all DOFs, f_v the
+  /// viscous nodal forces — the trapezoid rule that the Newmark energy identity books for them.
+  double damping_dissipation = 0.0;
   double assembly_seconds = 0.0;
   double linear_solve_seconds = 0.0;
   int linear_iterations = 0; ///< iterative solver: total CG iterations
@@ -253,13 +271,16 @@ public:
   [[nodiscard]] double max_displacement() const;
   /// Kinetic energy ½ vᵀ M v [J] of the last converged state (0 without SolverSettings::dynamic).
   [[nodiscard]] double kinetic_energy() const;
+  /// Kelvin–Voigt dissipation so far [J] (EquilibriumReport::damping_dissipation; 0 undamped).
+  [[nodiscard]] double damping_dissipation() const;
 
   /// The state for a checkpoint: the DOF values of the displacement, all of them in global DOF
   /// order on every process (distributed: gathered; the numbering depends on the process count,
   /// so a state is restored with the same number of processes), followed (with a cohesive
   /// interface) by each interface point's history (κ, previous opening) and the last time, and
   /// (with SolverSettings::dynamic) by the velocity and acceleration DOFs, the last time and the
-  /// interface's trapezoid work (CohesiveSummary::trapezoid_work).
+  /// interface's trapezoid work (CohesiveSummary::trapezoid_work), and (dynamic with damping in
+  /// some region) the Kelvin–Voigt dissipation so far.
   [[nodiscard]] std::vector<double> state() const;
   /// Restores a checkpointed state. Throws std::invalid_argument on a size mismatch.
   void set_state(const std::vector<double>& values);

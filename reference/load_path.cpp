@@ -1,6 +1,7 @@
 #include "reference/load_path.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 
@@ -18,6 +19,11 @@ LoadPath::LoadPath(FiniteStrainSolver& solver, const LoadState& start, const Loa
     : m_solver(solver), m_settings(settings), m_last(start), m_state(solver.state()) {
   if (settings.max_cutbacks < 0)
     throw std::invalid_argument("load path: max_cutbacks must be >= 0, got " + std::to_string(settings.max_cutbacks));
+  if (!(settings.interface_error_relative >= 0.0) || !(settings.interface_error_absolute >= 0.0) ||
+      !std::isfinite(settings.interface_error_relative) || !std::isfinite(settings.interface_error_absolute))
+    throw std::invalid_argument("load path: the interface energy tolerances must be finite and >= 0, got " +
+                                std::to_string(settings.interface_error_relative) + " and " +
+                                std::to_string(settings.interface_error_absolute) + " J");
 }
 
 namespace {
@@ -39,18 +45,42 @@ LoadStepReport LoadPath::advance(const LoadTarget& target) {
   // Bisection from the last converged load: `done` is the fraction of the interval reached,
   // `step` the increment currently trusted (halved on each failure, kept after a success).
   const LoadState from = m_last;
+  const bool control = m_settings.interface_error_relative > 0.0 || m_settings.interface_error_absolute > 0.0;
+  const double span = target.load.time - from.time;
   double done = 0.0, step = 1.0;
+  if (control && m_interface_step > 0.0 && span > 0.0) step = std::min(1.0, m_interface_step / span);
   while (done < 1.0) {
     const double f = std::min(1.0, done + step);
     const LoadState trial = f >= 1.0 ? target.load : interpolate(from, target.load, f);
     const EquilibriumReport r = m_solver.solve(trial);
     out.newton_iterations += r.newton_iterations;
+    bool grow = false;
+    if (r.converged && control) {
+      // |e| <= relative × ΔD + absolute, else undo the increment and halve it (LoadPathSettings).
+      const double error = std::abs(r.cohesive.step_time_integration_error);
+      const double tolerance =
+          m_settings.interface_error_relative * r.cohesive.step_dissipation + m_settings.interface_error_absolute;
+      if (error > tolerance) {
+        if (out.cutbacks < m_settings.max_cutbacks) {
+          m_solver.set_state(m_state);
+          ++out.cutbacks;
+          ++out.interface_rejections;
+          step *= 0.5;
+          continue;
+        }
+        out.interface_tolerance_exceeded = true;
+      }
+      // e ∝ h² relative to ΔD: doubling the step quadruples it (LoadPathSettings).
+      grow = 4.0 * error <= tolerance && out.cutbacks == out.interface_rejections;
+    }
     if (r.converged) {
+      out.interface_error += r.cohesive.step_time_integration_error;
       done = f;
       m_last = trial;
       m_state = m_solver.state();
       ++out.increments;
       out.equilibrium = r;
+      if (grow) step = std::min(1.0, 2.0 * step);
       continue;
     }
     if (out.cutbacks >= m_settings.max_cutbacks) {
@@ -72,6 +102,7 @@ LoadStepReport LoadPath::advance(const LoadTarget& target) {
     ++out.cutbacks;
     step *= 0.5;
   }
+  if (control) m_interface_step = step >= 1.0 || !(span > 0.0) ? 0.0 : step * span;
   out.converged = true;
   out.tool_force = out.equilibrium.tool_force;
   out.support_reaction = out.equilibrium.support_reaction;

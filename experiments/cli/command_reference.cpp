@@ -1,6 +1,7 @@
 // kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [--until T] [--levels L]
 // [--element-size H] [-o DIR] [--resume] [--no-fields] [--solver auto|direct|iterative] [--np N]
-// [--fracture auto|on|off] [--cohesive-viscous-time TAU] [--dynamic]: the finite-strain reference along the
+// [--fracture auto|on|off] [--cohesive-viscous-time TAU] [--dynamic] [--no-damping]
+// [--interface-energy-tolerance REL]: the finite-strain reference along the
 // scene's trajectory (issue 3),
 // written as profile.csv + manifest.json (+ fields.pvd), with a progress line per sample and
 // checkpoints to resume from; with --levels, a mesh convergence study over L refinements. `--np N`
@@ -48,6 +49,8 @@ struct ReferenceOptions {
   std::string fracture = "off";
   double viscous_time = 0.0; ///< τ [s] of the cohesive law's viscous regularisation (0: none)
   bool dynamic = false;      ///< the dynamic (inertial) step instead of the quasi-static one
+  bool no_damping = false;   ///< dynamic step: leave the scene's Kelvin–Voigt damping out
+  double interface_tolerance = ReferenceRunSettings{}.interface_error_relative; ///< dynamic + fracture: kinks control
   bool no_fields = false;
   std::string trajectory; ///< a haptic session file whose tool positions replace the scene's trajectories
   reference::LinearSolverChoice solver = reference::LinearSolverChoice::automatic;
@@ -70,6 +73,8 @@ struct ReferenceOptions {
   args.insert(args.end(), {"--fracture", o.fracture});
   if (o.viscous_time > 0.0) args.insert(args.end(), {"--cohesive-viscous-time", std::to_string(o.viscous_time)});
   if (o.dynamic) args.emplace_back("--dynamic");
+  if (o.no_damping) args.emplace_back("--no-damping");
+  args.insert(args.end(), {"--interface-energy-tolerance", std::to_string(o.interface_tolerance)});
   if (!o.out.empty()) args.insert(args.end(), {"-o", o.out});
   if (o.resume) args.emplace_back("--resume");
   if (o.no_fields) args.emplace_back("--no-fields");
@@ -112,6 +117,9 @@ void run_reference_command(const ReferenceOptions& o) {
   settings.fracture = o.fracture == "on" ? ReferenceFracture::on : o.fracture == "off" ? ReferenceFracture::off : ReferenceFracture::automatic;
   settings.cohesive_viscous_time = o.viscous_time;
   settings.dynamic = o.dynamic;
+  settings.damping = !o.no_damping;
+  settings.interface_error_relative = o.interface_tolerance;
+  if (o.interface_tolerance == 0.0) settings.interface_error_floor = 0.0; // the control off
   if (o.samples < 0) throw std::invalid_argument("--samples must be >= 1, got " + std::to_string(o.samples));
   if (o.samples > 0 || o.until >= 0.0) {
     if (scene.tools.empty()) throw std::invalid_argument("scene '" + scene.name + "' has no tool");
@@ -194,6 +202,13 @@ void add_reference_command(CLI::App& app) {
   cmd->add_flag("--dynamic", options->dynamic,
                 "dynamic (inertial) step: implicit Newmark average acceleration with the consistent mass of the "
                 "scene's density; the kinetic energy joins the manifest's energy (serial only)");
+  cmd->add_flag("--no-damping", options->no_damping,
+                "with --dynamic: leave out the scene's Kelvin-Voigt damping (its viscous stress (eta/E) C0 : dE/dt "
+                "and the damping dissipation in the manifest's energy)");
+  cmd->add_option("--interface-energy-tolerance", options->interface_tolerance,
+                  "with --dynamic and fracture: reject and halve a step whose time-integration error at the cohesive "
+                  "law's kinks exceeds REL x its cohesive dissipation + 1e-5 J_c A (default 0.005; 0: off)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--trajectory", options->trajectory,
                   "a haptic session file (kerf haptic --record): its tool positions replace the scene's trajectories");
   cmd->callback([options] { run_reference_command(*options); });

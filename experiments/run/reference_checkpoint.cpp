@@ -3,6 +3,7 @@
 #include "meshes/atomic_file.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <fstream>
 #include <limits>
@@ -13,8 +14,10 @@ namespace kerf {
 
 namespace {
 
-constexpr char checkpoint_magic[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '3'};
-/// Version 2 (before the dynamic step): no time-integration field; read as quasi-static.
+constexpr char checkpoint_magic[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '4'};
+/// Version 3 (before the Kelvin–Voigt damping): no damping field; read as undamped.
+constexpr char checkpoint_magic_v3[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '3'};
+/// Version 2 (before the dynamic step): no time-integration field either; read as quasi-static.
 constexpr char checkpoint_magic_v2[8] = {'K', 'E', 'R', 'F', 'R', 'E', 'F', '2'};
 
 class Writer {
@@ -99,7 +102,7 @@ bool resumable_record(const nlohmann::json& s) {
     const auto it = energy->find(key);
     if (it == energy->end() || !it->is_number()) return false;
   }
-  for (const char* key : {"contact_energy_J", "kinetic_energy_J", "cohesive_trapezoid_work_J"}) { // optional (older records)
+  for (const char* key : {"contact_energy_J", "kinetic_energy_J", "cohesive_trapezoid_work_J", "damping_dissipation_J"}) { // optional (older records)
     const auto it = energy->find(key);
     if (it != energy->end() && !it->is_number()) return false;
   }
@@ -125,6 +128,7 @@ void write_reference_checkpoint(const ReferenceCheckpoint& c, const std::filesys
     w.i32(c.refinements);
     w.i32(c.processes);
     w.i32(c.dynamic ? 1 : 0);
+    w.i32(c.damped ? 1 : 0);
     w.u64(c.indices.size());
     for (std::size_t i : c.indices) w.u64(i);
     w.u64(c.solved);
@@ -144,6 +148,7 @@ void write_reference_checkpoint(const ReferenceCheckpoint& c, const std::filesys
     }
     w.str(c.samples.dump());
     w.f64(c.solve_seconds);
+    w.f64(c.interface_step);
     out.flush();
     if (!out) throw std::runtime_error("reference: writing checkpoint " + tmp.string() + " failed");
   });
@@ -156,7 +161,8 @@ ReferenceCheckpoint read_reference_checkpoint(const std::filesystem::path& file)
   in.read(magic, sizeof magic);
   if (!in) throw std::runtime_error("reference checkpoint " + file.string() + ": not a kerf reference checkpoint");
   const bool version_2 = std::equal(magic, magic + 8, checkpoint_magic_v2);
-  if (!version_2 && !std::equal(magic, magic + 8, checkpoint_magic))
+  const bool version_3 = std::equal(magic, magic + 8, checkpoint_magic_v3);
+  if (!version_2 && !version_3 && !std::equal(magic, magic + 8, checkpoint_magic))
     throw std::runtime_error("reference checkpoint " + file.string() + ": not a kerf reference checkpoint");
   std::error_code size_error;
   const std::uint64_t bytes = std::filesystem::file_size(file, size_error);
@@ -172,6 +178,11 @@ ReferenceCheckpoint read_reference_checkpoint(const std::filesystem::path& file)
     if (integration != 0 && integration != 1)
       throw std::runtime_error("reference checkpoint " + file.string() + ": corrupt time integration");
     c.dynamic = integration == 1;
+  }
+  if (!version_2 && !version_3) {
+    const auto damped = r.pod<std::int32_t>();
+    if (damped != 0 && damped != 1) throw std::runtime_error("reference checkpoint " + file.string() + ": corrupt damping");
+    c.damped = damped == 1;
   }
   c.indices.resize(r.count(sizeof(std::uint64_t)));
   for (std::size_t& i : c.indices) i = r.u64();
@@ -197,6 +208,11 @@ ReferenceCheckpoint read_reference_checkpoint(const std::filesystem::path& file)
   // sample; anything else is a corrupt checkpoint, not a JSON exception.
   c.samples = nlohmann::json::parse(r.str(), nullptr, /*allow_exceptions=*/false);
   c.solve_seconds = r.f64();
+  if (!version_2 && !version_3) {
+    c.interface_step = r.f64();
+    if (!(c.interface_step >= 0.0) || !std::isfinite(c.interface_step))
+      throw std::runtime_error("reference checkpoint " + file.string() + ": corrupt interface step");
+  }
   if (c.solved > c.indices.size())
     throw std::runtime_error("reference checkpoint " + file.string() + ": more samples solved than requested");
   if (c.samples.is_discarded() || !c.samples.is_array() || c.samples.size() != c.solved ||

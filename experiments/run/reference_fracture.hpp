@@ -34,6 +34,7 @@ struct CrackPathInfo {
                                       ///< geometry's `cut_element_size` grading when that is finer
   double elements_in_zone = 0.0;      ///< l_cz / h
   double viscosity = 0.0;             ///< η [Pa s/m] of the law's viscous regularisation (0: none)
+  double interface_area = 0.0;        ///< reference area of the crack path joined by the law [m^2]
   std::string warning;                ///< non-empty when l_cz / h < 3 (Turon et al. 2007)
 };
 
@@ -53,16 +54,19 @@ CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem&
 /// the tool contact, cohesive dissipation, viscous dissipation, friction dissipation (0: the
 /// reference tool is frictionless), and the balance error
 /// (W − stored − interface − contact − kinetic − dissipations) / max(W, stored + …), with the kinetic
-/// energy ½ vᵀ M v of the dynamic step (0 for a quasi-static run). With the dynamic step
-/// (Newmark average acceleration = the trapezoidal rule) the trapezoid-rule work of the tools'
-/// forces (their reactions, which include the inertia of the driven nodes) equals ΔK plus the
-/// trapezoid rule of the internal forces' work exactly (Hughes, The Finite Element Method, §9.1),
-/// so what the balance then measures is only the trapezoid rule's error on the nonlinear internal
-/// forces over a step. The largest such error is the cohesive law's kinks (a point that opens past
-/// the peak or past δ_f within one step): the interface's own trapezoid work is measured point by
-/// point (reference::CohesiveSummary::trapezoid_work), and its excess over the interface energy
-/// and cohesive dissipation is booked as the time integration's error at the kinks,
-/// `cohesive_time_integration_J` (0 for a quasi-static run), reported so it can be kept small.
+/// energy ½ vᵀ M v and the Kelvin–Voigt damping dissipation of the dynamic step (0 for a
+/// quasi-static run). With the dynamic step (Newmark average acceleration = the trapezoidal rule)
+/// the trapezoid-rule work of the tools' forces (their reactions, which include the inertia of the
+/// driven nodes) equals ΔK plus the trapezoid rule of the internal and viscous forces' work exactly
+/// (Hughes, The Finite Element Method, §9.1), so what the balance then measures is only the
+/// trapezoid rule's error on the nonlinear internal forces over a step. The largest such error is
+/// the cohesive law's kinks (a point that opens past the peak or past δ_f within one step): the
+/// interface's own trapezoid work is measured point by point
+/// (reference::CohesiveSummary::trapezoid_work), and its excess over the interface energy and
+/// cohesive dissipation is reported as the time integration's error at the kinks,
+/// `cohesive_time_integration_J` (0 for a quasi-static run). It is not booked in the balance: the
+/// load path's interface energy control keeps it small (reference/load_path.hpp), and the balance
+/// error includes it.
 /// The trapezoid rule is exact for a force linear between samples; a crack that advances by an
 /// unstable jump between two samples (a snap-through of an under-resolved cohesive zone) releases
 /// energy that a quasi-static solution does not see, and the balance error then measures that loss.
@@ -71,9 +75,10 @@ public:
   /// One solved sample: the tool reference points [m] and the forces of the tools on the body [N]
   /// (one entry per tool), the body's strain energy [J], the interface summary and the contact's
   /// penalty energy [J] (EquilibriumReport::contact_energy).
+  /// `kinetic_energy` and `damping_dissipation` [J]: the dynamic step's (FiniteStrainSolver).
   void add_sample(const std::vector<Eigen::Vector3d>& positions, const std::vector<Eigen::Vector3d>& forces_on_body,
                   double strain_energy, const reference::CohesiveSummary& interface, double contact_energy = 0.0,
-                  double kinetic_energy = 0.0);
+                  double kinetic_energy = 0.0, double damping_dissipation = 0.0);
   [[nodiscard]] double external_work() const { return m_work; }
   [[nodiscard]] double balance_error() const;
   /// The interface's trapezoid work minus its stored energy and cohesive dissipation [J] (dynamic
@@ -85,7 +90,7 @@ public:
 
 private:
   std::vector<Eigen::Vector3d> m_positions, m_forces;
-  double m_work = 0.0, m_strain = 0.0, m_contact = 0.0, m_kinetic = 0.0;
+  double m_work = 0.0, m_strain = 0.0, m_contact = 0.0, m_kinetic = 0.0, m_damping = 0.0;
   reference::CohesiveSummary m_interface;
 };
 

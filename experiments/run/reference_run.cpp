@@ -35,6 +35,7 @@ reference::MaterialRegion region_of(const Material& m) {
   r.youngs_modulus = m.youngs_modulus;
   r.poisson_ratio = m.poisson_ratio;
   r.density = m.density;
+  r.damping = m.damping;
   return r;
 }
 
@@ -238,6 +239,17 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   ReferenceProblem rp = reference_problem(scene, mesh);
   const CrackPathInfo crack = add_crack_path(scene, rp.problem, settings.fracture, settings.refinements,
                                               settings.cohesive_viscous_time);
+  // Kelvin–Voigt damping: the dynamic step's, when asked for (the quasi-static solve has no rate).
+  bool damped = false;
+  for (reference::MaterialRegion& region : rp.problem.materials) {
+    if (!(settings.dynamic && settings.damping)) region.damping = 0.0;
+    damped = damped || region.damping > 0.0;
+  }
+  if (!(settings.interface_error_relative >= 0.0) || !(settings.interface_error_floor >= 0.0) ||
+      !std::isfinite(settings.interface_error_relative) || !std::isfinite(settings.interface_error_floor))
+    throw std::invalid_argument("reference: the interface energy tolerances must be finite and >= 0, got " +
+                                std::to_string(settings.interface_error_relative) + " and " +
+                                std::to_string(settings.interface_error_floor));
   if (!crack.warning.empty()) std::fprintf(stderr, "reference %s: warning: %s\n", scene.name.c_str(), crack.warning.c_str());
   // The crack extent is measured along the blade's cutting direction (c of paper 001 Fig. 3), or
   // downwards from the grasped top for a tear.
@@ -281,6 +293,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   cp.refinements = settings.refinements;
   cp.processes = solver.process_count();
   cp.dynamic = settings.dynamic;
+  cp.damped = damped;
   cp.indices = indices;
   cp.last = load_of(0);
   std::optional<std::size_t> resumed_from;
@@ -298,6 +311,11 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                (saved.dynamic ? "dynamic" : "quasi-static") + " run and this run is " +
                                (cp.dynamic ? "dynamic (--dynamic)" : "quasi-static") +
                                ": resume with the same time integration");
+    if (saved.damped != cp.damped)
+      throw std::runtime_error("reference: " + checkpoint_file.string() + " is from a run " +
+                               (saved.damped ? "with" : "without") + " the scene's Kelvin-Voigt damping and this run is " +
+                               (cp.damped ? "damped" : "undamped (--no-damping, or a checkpoint from before the damping)") +
+                               ": resume with the same damping");
     solver.set_state(saved.state);
     cp = std::move(saved);
     cp.last.time = cp.last.load_factor * T; // the load factor is t/T (load_of), also between samples
@@ -311,7 +329,15 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   }
   if (settings.write_fields) fs::create_directories(dir / "fields");
 
-  reference::LoadPath path(solver, cp.last);
+  reference::LoadPathSettings path_settings;
+  if (settings.dynamic && crack.active) {
+    // The interface energy control (reference/load_path.hpp): |e| <= rel ΔD + floor J_c A per step.
+    path_settings.interface_error_relative = settings.interface_error_relative;
+    path_settings.interface_error_absolute =
+        settings.interface_error_floor * scene.material.fracture_toughness * crack.interface_area;
+  }
+  reference::LoadPath path(solver, cp.last, path_settings);
+  path.set_interface_step(cp.interface_step);
   std::vector<double> solved_times;
   for (std::size_t k : indices) solved_times.push_back(rp.times[k]);
   std::string stop;
@@ -372,7 +398,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     }
     previous_interface = interface;
     energy.add_sample(tool_positions, forces_on_body, solver.strain_energy(), step.equilibrium.cohesive,
-                      step.equilibrium.contact_energy, solver.kinetic_energy());
+                      step.equilibrium.contact_energy, solver.kinetic_energy(), solver.damping_dissipation());
     for (std::size_t j = 0; j < rp.tools.size(); ++j) {
       ProfileRow row;
       row.t = rp.times[k];
@@ -390,6 +416,8 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                           {"newton_iterations", step.newton_iterations},
                           {"cutbacks", step.cutbacks},
                           {"increments", step.increments},
+                          {"interface_rejections", step.interface_rejections},
+                          {"interface_tolerance_exceeded", step.interface_tolerance_exceeded},
                           {"residual_N", step.final_residual},
                           {"seconds", cost},
                           {"tool_force_N", vec_json(tool_force)},
@@ -405,6 +433,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     newton_total += step.newton_iterations;
     cp.solved = i + 1;
     cp.last = path.last_converged_load();
+    cp.interface_step = path.interface_step();
     if (settings.write_fields) {
       if (pieces)
         solver.write_fields(dir / "fields" / step_name(i, true), load); // collective; atomic inside
@@ -446,6 +475,9 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                   {"checkpoint_every", settings.checkpoint_every},
                   {"time_integration", settings.dynamic ? "dynamic: Newmark average acceleration (beta = 1/4, gamma = 1/2), consistent mass"
                                                         : "quasi-static"},
+                  {"kelvin_voigt_damping", damped},
+                  {"interface_error_relative", path_settings.interface_error_relative},
+                  {"interface_error_absolute_J", path_settings.interface_error_absolute},
                   {"write_fields", settings.write_fields}}}};
   m["mesh"] = {{"nodes", mesh.nodes.rows()},
                {"tetrahedra", mesh.tets.rows()},
@@ -491,6 +523,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                                 {"elements_in_zone", crack.elements_in_zone},
                                                 {"viscous_time_s", settings.cohesive_viscous_time},
                                                 {"viscosity_Pa_s_per_m", crack.viscosity},
+                                                {"interface_area_m2", crack.interface_area},
                                                 {"warning", crack.warning}}
                                : nlohmann::json(nullptr);
   m["samples"] = cp.samples;

@@ -47,6 +47,16 @@ struct ReferenceRunSettings {
   /// joins the manifest's energy. The time step is the spacing of the solved samples (halved by the
   /// load path's cut-backs). Serial only.
   bool dynamic = false;
+  /// Dynamic step: the scene's Kelvin–Voigt damping (its materials' `damping` η, the viscous
+  /// stress (η/E) ℂ₀ : Ė of reference/material/kelvin_voigt.hpp), its dissipation in the manifest's
+  /// energy; false leaves it out (an undamped run). The quasi-static step has no rate: unused.
+  bool damping = true;
+  /// Dynamic step with fracture: the load path's interface energy control
+  /// (reference::LoadPathSettings): a step whose time integration error at the cohesive law's kinks
+  /// exceeds interface_error_relative × its cohesive dissipation + interface_error_floor × J_c A
+  /// (A the crack path's area) is rejected and re-solved in halves. Both 0: off.
+  double interface_error_relative = 0.005;
+  double interface_error_floor = 1e-5;
   /// Fault injection for tests (issue 10): passed to the solver as
   /// reference::SolverSettings::residual_fault (a NaN in the chosen Newton iterations' residual).
   std::function<bool(const reference::LoadState& load, int newton_iteration)> residual_fault;

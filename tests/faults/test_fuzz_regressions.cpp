@@ -171,6 +171,7 @@ TEST(FuzzRegressions, CorruptReferenceCheckpointsAreErrorsNotJsonExceptionsOrHug
   c.refinements = 1;
   c.processes = 3;
   c.dynamic = true;
+  c.damped = true;
   c.indices = {0, 4, 8};
   c.solved = 2;
   c.last.load_factor = 0.5;
@@ -186,6 +187,7 @@ TEST(FuzzRegressions, CorruptReferenceCheckpointsAreErrorsNotJsonExceptionsOrHug
     c.samples.push_back({{"index", 4 * k}, {"newton_iterations", 3}, {"contact_points", k}});
   }
   c.solve_seconds = 1.25;
+  c.interface_step = 2.5e-4;
   const fs::path file = scratch("checkpoint.bin");
   write_reference_checkpoint(c, file);
   const ReferenceCheckpoint back = read_reference_checkpoint(file);
@@ -199,22 +201,42 @@ TEST(FuzzRegressions, CorruptReferenceCheckpointsAreErrorsNotJsonExceptionsOrHug
   EXPECT_EQ(back.samples, c.samples);
   EXPECT_EQ(back.solve_seconds, 1.25);
   EXPECT_TRUE(back.dynamic);
+  EXPECT_TRUE(back.damped);
+  EXPECT_EQ(back.interface_step, 2.5e-4);
 
-  // Version 2 (before the dynamic step; the saved regression inputs above are version 2 too):
-  // the same bytes without the time-integration field after the process count, read as a
-  // quasi-static run. Offset of that field: magic 8 + sha (8 + 64) + degree, refinements,
-  // processes 3 × 4 = 92.
+  // Version 3 (before the damping): the same bytes without the damping field after the time
+  // integration and without the load path's interface step at the end, read as undamped; version 2 (before the dynamic step; the saved regression inputs
+  // above are version 2 too): without the time-integration field either, read as a quasi-static
+  // run. Offsets: magic 8 + sha (8 + 64) + degree, refinements, processes 3 × 4 = 92 (time
+  // integration), 96 (damping).
   {
     std::ifstream in(file, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    ASSERT_EQ(bytes.substr(0, 8), "KERFREF3");
-    std::string v2 = bytes;
+    ASSERT_EQ(bytes.substr(0, 8), "KERFREF4");
+    std::string v3 = bytes;
+    v3[7] = '3';
+    v3.erase(v3.size() - 8);
+    v3.erase(96, 4);
+    const fs::path v3_file = scratch("checkpoint_v3.bin");
+    std::ofstream(v3_file, std::ios::binary) << v3;
+    const ReferenceCheckpoint third = read_reference_checkpoint(v3_file);
+    EXPECT_TRUE(third.dynamic);
+    EXPECT_FALSE(third.damped);
+    EXPECT_EQ(third.interface_step, 0.0);
+    EXPECT_EQ(third.state, c.state);
+    EXPECT_EQ(third.samples, c.samples);
+    std::string bad_damping = bytes;
+    bad_damping[96] = 7;
+    std::ofstream(v3_file, std::ios::binary) << bad_damping;
+    EXPECT_NE(message(v3_file).find("corrupt damping"), std::string::npos);
+    std::string v2 = v3;
     v2[7] = '2';
     v2.erase(92, 4);
     const fs::path old_file = scratch("checkpoint_v2.bin");
     std::ofstream(old_file, std::ios::binary) << v2;
     const ReferenceCheckpoint old = read_reference_checkpoint(old_file);
     EXPECT_FALSE(old.dynamic);
+    EXPECT_FALSE(old.damped);
     EXPECT_EQ(old.indices, c.indices);
     EXPECT_EQ(old.state, c.state);
     EXPECT_EQ(old.samples, c.samples);

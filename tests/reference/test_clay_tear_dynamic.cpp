@@ -2,7 +2,10 @@
 // styluses pull the clay block apart at 5 mm/s each; the cohesive mid-plane (20 × 20 mm,
 // J_c = 50 J/m², σ_c = 50 kPa) tears with no viscous regularisation (τ = 0): the energy the block
 // releases when the tear runs away goes into the kinetic energy of the halves instead of a
-// viscous term, and the ledger keeps it.
+// viscous term, and the ledger keeps it. The scene's Kelvin–Voigt damping (10 Pa s) is on, and the
+// load path's interface energy control (ReferenceRunSettings::interface_error_relative, 0.5% of each
+// step's cohesive dissipation + 10⁻⁵ J_c A) re-solves the steps in which points cross the law's
+// kinks in halves.
 // Time steps: the samples every 28 ms through the slow pull (quasi-static in all but name: the
 // kinetic energy is below 10⁻⁵ of the work), every 1 ms (the trajectory's rate) from t = 1.03 s
 // (the tear starts at 1.050 s; the quasi-static path stops at 1.05 s, docs/cohesive-fracture.md)
@@ -10,10 +13,14 @@
 // Expected values, independent of the solver:
 //   separation     the failed area reaches the whole plane A = 20 mm × 20 mm and the cohesive
 //                  dissipation is J_c A = 20 mJ (the area under the bilinear law, per area);
-//   energy         W = U + K + interface energy + cohesive dissipation + the time integration's
-//                  error at the law's kinks (measured point by point, reported) at every sample, to
-//                  1% (issue 4): the trapezoidal rule's energy identity (Hughes, The Finite Element
-//                  Method, §9.1) for the hands' work from their reactions;
+//   energy         W = U + K + interface energy + cohesive dissipation + damping dissipation at
+//                  every sample, to 1% (issue 4), without booking the time integration's error at
+//                  the law's kinks: the trapezoidal rule's energy identity (Hughes, The Finite
+//                  Element Method, §9.1) for the hands' work from their reactions;
+//   kinks          the time integration's error at the law's kinks (measured point by point and
+//                  reported) below 1% of J_c A: the interface energy control bounds its sum by
+//                  0.5% of the dissipation J_c A plus 10⁻⁵ J_c A per accepted step (reference/
+//                  load_path.hpp), 0.5% + 0.14% for the ~140 steps of this run;
 //   kinetic        once separated the halves carry the energy they released as kinetic energy
 //                  (it was 38% of the work that left the quasi-static ledger): on average over
 //                  the samples after separation more than 20% of W;
@@ -49,7 +56,8 @@ struct TearRun {
 /// clay_tear, fracture on, dynamic, τ = 0: samples every 28 ms until `from` [s], then every
 /// `window_step` seconds from `from` to `until`; `rate` [Hz] resamples both trajectories (the
 /// scene's is 1 kHz).
-TearRun run_tear(double rate, double from, double window_step, double until, bool print_rows) {
+TearRun run_tear(double rate, double from, double window_step, double until, bool print_rows,
+               double interface_error_relative = ReferenceRunSettings{}.interface_error_relative, bool damping = true) {
   namespace fs = std::filesystem;
   Scene scene = read_scene(fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / "clay_tear.toml");
   for (Tool& tool : scene.tools) tool.trajectory.rate = rate;
@@ -59,6 +67,9 @@ TearRun run_tear(double rate, double from, double window_step, double until, boo
   settings.dynamic = true;
   settings.write_fields = false;
   settings.checkpoint_every = 100000;
+  settings.interface_error_relative = interface_error_relative;
+  if (interface_error_relative == 0.0) settings.interface_error_floor = 0.0; // the control off
+  settings.damping = damping;
   const auto at = [&](double t) { return static_cast<std::size_t>(std::llround(t * rate)); };
   // The hands start from rest at 5 mm/s: the first steps short (2, 2, 4, 8 ms; a first step of
   // 28 ms from rest needs three cut-backs), then every 28 ms.
@@ -97,14 +108,19 @@ TearRun run_tear(double rate, double from, double window_step, double until, boo
     if (out.separation_time < 0.0 && failed >= out.plane * (1.0 - 1e-9)) out.separation_time = t;
     if (print_rows)
       std::printf("t %.4f s  left %8.3f N  right %8.3f N  failed %6.1f mm2  W %7.3f  U %7.3f  K %7.3f  cohesive %6.3f  "
-                  "kinks %6.3f mJ  balance %+.3f%%  Newton %d  cut-backs %d\n",
+                  "kinks %6.3f mJ  damping %6.3f mJ  balance %+.3f%%  Newton %d  cut-backs %d (rejected %d)\n",
                   t, left, right, failed * 1e6, e.at("external_work_J").get<double>() * 1e3,
                   e.at("stored_elastic_energy_J").get<double>() * 1e3, e.at("kinetic_energy_J").get<double>() * 1e3,
                   e.at("cohesive_dissipation_J").get<double>() * 1e3, e.at("cohesive_time_integration_J").get<double>() * 1e3,
-                  100.0 * e.at("balance_error").get<double>(), s.at("newton_iterations").get<int>(),
-                  s.at("cutbacks").get<int>());
+                  e.at("damping_dissipation_J").get<double>() * 1e3, 100.0 * e.at("balance_error").get<double>(),
+                  s.at("newton_iterations").get<int>(), s.at("cutbacks").get<int>(), s.at("interface_rejections").get<int>());
   }
   const auto& last = out.manifest.at("samples").back().at("energy");
+  int rejections = 0;
+  for (const auto& s : out.manifest.at("samples")) rejections += s.at("interface_rejections").get<int>();
+  std::printf("clay_tear dynamic (control %.4g, damping %s): %d steps rejected by the interface energy control, "
+              "damping dissipation %.3f mJ\n",
+              interface_error_relative, damping ? "on" : "off", rejections, last.at("damping_dissipation_J").get<double>() * 1e3);
   std::printf("clay_tear dynamic (window step %.2f ms from t = %.3f s): peak %.3f N at t = %.4f s, separated at t = %.4f s, worst balance "
               "%.3f%% at t = %.4f s, time-integration error at the kinks %.3f mJ (%.1f%% of J_c A), Newton %d, solve %.1f s, "
               "kinetic at the end %.2f mJ of W = %.2f mJ\n",
@@ -124,7 +140,8 @@ TEST(ClayTearDynamic, TearToSeparationKeepsTheEnergyBalance) {
   ASSERT_GE(r.separation_time, 0.0) << "the plane never failed completely";
   EXPECT_NEAR(last.at("cohesive_dissipation_J").get<double>(), r.toughness * r.plane, 0.02 * r.toughness * r.plane);
   EXPECT_EQ(last.at("viscous_dissipation_J").get<double>(), 0.0);
-  EXPECT_LT(r.worst_balance, 0.01);
+  EXPECT_GT(last.at("damping_dissipation_J").get<double>(), 0.0);
+  EXPECT_LT(r.worst_balance, 0.01); // the kinks' error is not booked (EnergyBookkeeping::balance_error)
   // The halves' kinetic energy after separation, averaged over the samples (K and U exchange
   // while they vibrate: K swings between 3 and 46 mJ of W = 69 mJ, docs/cohesive-fracture.md).
   double kinetic = 0.0;
@@ -136,22 +153,25 @@ TEST(ClayTearDynamic, TearToSeparationKeepsTheEnergyBalance) {
     }
   ASSERT_GT(after, 20);
   EXPECT_GT(kinetic / after, 0.2 * last.at("external_work_J").get<double>());
-  // The time integration's error at the law's kinks, booked in the balance, stays a minor term:
-  // measured 14.3% of J_c A here, 10.0% with 1 ms steps from t = 1.0 s and 33% with 2 ms
-  // (docs/cohesive-fracture.md).
+  // The time integration's error at the law's kinks: below 1% of J_c A under the interface energy
+  // control (the bound in the file comment; without the control it was 14.3% of J_c A on these
+  // samples, docs/cohesive-fracture.md).
   const double kinks = last.at("cohesive_time_integration_J").get<double>();
-  EXPECT_GE(kinks, 0.0);
-  EXPECT_LT(kinks, 0.2 * r.toughness * r.plane);
+  EXPECT_LT(std::abs(kinks), 0.01 * r.toughness * r.plane);
   EXPECT_NEAR(r.peak, 12.25, 0.03 * 12.25);
 }
 
-// The time-step table of docs/cohesive-fracture.md (run by hand: --gtest_also_run_disabled_tests
-// --gtest_filter='*TimeStepTable*'): the tear window from t = 1.0 s to 1.12 s solved with 2, 1 and
-// 0.5 ms steps.
-TEST(ClayTearDynamic, DISABLED_TimeStepTable) {
-  for (const auto& [rate, step] : {std::pair{1000.0, 0.002}, std::pair{1000.0, 0.001}, std::pair{2000.0, 0.0005}})
-    (void)run_tear(rate, 1.0, step, 1.12, step == 0.001);
+// The control's cost (docs/cohesive-fracture.md; run by hand: --gtest_also_run_disabled_tests
+// --gtest_filter='*ControlCost*'): the ctest's samples with the interface energy control off, and
+// on without the damping.
+TEST(ClayTearDynamic, DISABLED_ControlCost) {
+  (void)run_tear(1000.0, 1.03, 0.001, 1.085, false, 0.0, true);
+  (void)run_tear(1000.0, 1.03, 0.001, 1.085, false, ReferenceRunSettings{}.interface_error_relative, false);
 }
+
+// The damped halves (docs/cohesive-fracture.md; run by hand: --gtest_filter='*DampedHold*' with
+// --gtest_also_run_disabled_tests): the tear and 245 ms after it, 1 ms steps.
+TEST(ClayTearDynamic, DISABLED_DampedHold) { (void)run_tear(1000.0, 1.03, 0.001, 1.3, true); }
 
 } // namespace
 } // namespace kerf

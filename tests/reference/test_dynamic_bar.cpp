@@ -18,6 +18,13 @@
 //   energy         the trapezoid-rule work of the end force equals strain + kinetic energy at every
 //                  step: the trapezoidal rule's energy identity (Hughes, The Finite Element Method,
 //                  §9.1; exact for a linear system; the strain here is 10⁻⁴, so nearly linear)
+// The damped bar (MaterialRegion::damping, reference/material/kelvin_voigt.hpp): the same bar
+// released from a static stretch vibrates freely; with ν = 0 the Kelvin–Voigt stress is the 1-D
+// σ = E ε + τ E ε̇ (τ = η/E), stiffness-proportional damping, so mode k decays with the damping
+// ratio ζ_k = ω_k τ/2 (Chopra, Dynamics of Structures, §11.4) and the logarithmic decrement of
+// the first mode's free vibration is δ = 2πζ₁/√(1 − ζ₁²) (Chopra §2.2), with ω₁ = (π/2) c/L
+// (the fixed–free bar's first mode; Graff §2.1). Higher modes (ω₃ = 3ω₁, ζ₃ = 3ζ₁) decay nine
+// times faster, so from the second period on the end motion is the first mode alone.
 
 #include "reference/finite_strain_solver.hpp"
 #include "reference/load_path.hpp"
@@ -26,7 +33,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <cstdio>
+#include <vector>
 
 namespace kerf::reference {
 namespace {
@@ -83,16 +92,90 @@ TEST(DynamicBar, SuddenlyLoadedBarReachesTwiceTheStaticDisplacement) {
   EXPECT_LT(worst_energy, 1e-5); // measured 4e-7 (the law's nonlinearity at strain 1e-4)
 }
 
+/// The end face's mean displacement ū = (1/A) ∫ u dA of the box bar (see the first test).
+double end_displacement(const FiniteStrainSolver& solver, double L, double b) {
+  const double u00 = solver.displacement_at({L, 0.0, 0.0}).x(), ubb = solver.displacement_at({L, b, b}).x();
+  const double ub0 = solver.displacement_at({L, b, 0.0}).x(), u0b = solver.displacement_at({L, 0.0, b}).x();
+  const double centre = solver.displacement_at({L, 0.5 * b, 0.5 * b}).x();
+  const bool diagonal_00_bb = std::abs(centre - 0.5 * (u00 + ubb)) <= std::abs(centre - 0.5 * (ub0 + u0b));
+  return diagonal_00_bb ? (2.0 * (u00 + ubb) + ub0 + u0b) / 6.0 : (2.0 * (ub0 + u0b) + u00 + ubb) / 6.0;
+}
+
+TEST(DynamicBar, DampedFreeVibrationDecaysWithTheFirstModesDampingRatio) {
+  const double L = 0.1, b = 0.01, E = 1e6, rho = 1000.0, sigma = 100.0; // strain σ/E = 1e-4
+  const double c = std::sqrt(E / rho), omega_1 = 0.5 * std::numbers::pi * c / L;
+  const double zeta_1 = 0.05, tau = 2.0 * zeta_1 / omega_1; // ζ₁ = ω₁τ/2
+  FiniteStrainProblem p;
+  p.mesh = test::named_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(L, b, b), 20, 1, 1);
+  p.materials.push_back({"body", LawKind::neo_hookean, E, 0.0, rho, tau * E}); // η = τ E
+  p.displacement_boundaries.push_back({"xmin", DisplacementBoundary::Kind::bonded, {}, {}});
+  p.tractions.push_back({"xmax", Eigen::Vector3d(sigma * b * b, 0.0, 0.0)});
+  SolverSettings settings;
+  settings.dynamic = true;
+  FiniteStrainSolver solver(p, settings);
+  // At rest under the end stress (h = 0: a quasi-static solve), released at t = 0: load factor 0.
+  ASSERT_TRUE(solver.solve({1.0, Eigen::Vector3d::Zero(), 0.0}).converged);
+  const double F = sigma * b * b, u_static = end_displacement(solver, L, b), U0 = solver.strain_energy();
+  const double period = 2.0 * std::numbers::pi / omega_1;
+  const int steps_per_period = 200, steps = 700; // 3.5 periods: three peaks after t = 0
+  const double h = period / steps_per_period;
+  double u_prev = u_static, work = 0.0, worst_energy = 0.0;
+  std::vector<double> u_history{u_static}, peaks, peak_times;
+  for (int k = 1; k <= steps; ++k) {
+    const EquilibriumReport r = solver.solve({0.0, Eigen::Vector3d::Zero(), k * h});
+    ASSERT_TRUE(r.converged) << "t = " << k * h << ": " << r.failure;
+    const double u = end_displacement(solver, L, b);
+    // The trapezoid-rule work of the end force: F at t = 0, 0 from t = h on.
+    work += 0.5 * ((k == 1 ? F : 0.0) + 0.0) * (u - u_prev);
+    // W = ΔU + K + D: the Newmark energy identity with the viscous forces' trapezoid work booked as
+    // the damping dissipation (EquilibriumReport::damping_dissipation).
+    const double ledger = solver.strain_energy() - U0 + r.kinetic_energy + r.damping_dissipation;
+    worst_energy = std::max(worst_energy, std::abs(work - ledger) / (F * u_static));
+    ASSERT_GE(r.damping_dissipation, 0.0);
+    u_history.push_back(u);
+    u_prev = u;
+  }
+  // Positive peaks of the end displacement after t = 0, refined by a parabola through the three
+  // samples around each.
+  for (std::size_t k = 1; k + 1 < u_history.size(); ++k)
+    if (u_history[k] > u_history[k - 1] && u_history[k] >= u_history[k + 1] && u_history[k] > 0.0) {
+      const double a = u_history[k - 1], m = u_history[k], z = u_history[k + 1];
+      const double shift = 0.5 * (a - z) / (a - 2.0 * m + z);
+      peaks.push_back(m - 0.25 * (a - z) * shift);
+      peak_times.push_back((static_cast<double>(k) + shift) * h);
+    }
+  ASSERT_GE(peaks.size(), 3u);
+  // From the second peak on (the higher modes have decayed, see the file comment).
+  const double decrement = std::log(peaks[1] / peaks[2]);
+  const double damped_period = peak_times[2] - peak_times[1];
+  const double expected = 2.0 * std::numbers::pi * zeta_1 / std::sqrt(1.0 - zeta_1 * zeta_1);
+  const double D = solver.damping_dissipation();
+  std::printf("damped bar: log decrement %.5f (closed form %.5f), damped period %.6f s (closed form %.6f s), "
+              "worst |W - dU - K - D| %.2e F u_s, D %.4e J of U0 %.4e J after 3.5 periods\n",
+              decrement, expected, damped_period, period / std::sqrt(1.0 - zeta_1 * zeta_1), worst_energy, D, U0);
+  // 2%: the 20 P1 elements' first mode is a little stiffer than the continuum's (ω₁ enters ζ₁).
+  EXPECT_NEAR(decrement, expected, 0.02 * expected);
+  EXPECT_NEAR(damped_period, period / std::sqrt(1.0 - zeta_1 * zeta_1), 0.01 * period);
+  EXPECT_LT(worst_energy, 1e-5);
+  // After 3.5 periods of ζ₁ = 5% the first mode keeps e^{−2·3.5·2πζ₁/√(1−ζ₁²)} = 11% of its
+  // energy: most of the released energy is dissipated.
+  EXPECT_GT(D, 0.8 * U0);
+  EXPECT_LT(D, U0);
+}
+
 // A cut-back restores the dynamic state: a load path whose first attempt at t = 2h fails (a NaN
 // injected in its residual, SolverSettings::residual_fault) cuts back to t = h and goes on to 2h; the
 // failed attempt must leave u, v and a as they were, so the result equals, bit for bit, the path
 // that solves t = h and t = 2h directly (the independent run).
-TEST(DynamicBar, CutBackRestoresVelocityAndAcceleration) {
-  const double L = 0.1, b = 0.01, E = 1e6, rho = 1000.0, sigma = 100.0, h = 1e-4;
+// The same with Kelvin–Voigt damping: the restore carries the viscous forces and the dissipation.
+class DynamicBarCutBack : public ::testing::TestWithParam<double> {};
+
+TEST_P(DynamicBarCutBack, RestoresVelocityAccelerationAndDamping) {
+  const double L = 0.1, b = 0.01, E = 1e6, rho = 1000.0, sigma = 100.0, h = 1e-4, eta = GetParam();
   auto problem = [&] {
     FiniteStrainProblem p;
     p.mesh = test::named_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(L, b, b), 10, 1, 1);
-    p.materials.push_back({"body", LawKind::neo_hookean, E, 0.0, rho});
+    p.materials.push_back({"body", LawKind::neo_hookean, E, 0.0, rho, eta});
     p.displacement_boundaries.push_back({"xmin", DisplacementBoundary::Kind::bonded, {}, {}});
     p.tractions.push_back({"xmax", Eigen::Vector3d(sigma * b * b, 0.0, 0.0)});
     return p;
@@ -120,10 +203,16 @@ TEST(DynamicBar, CutBackRestoresVelocityAndAcceleration) {
   EXPECT_EQ(first.increments, 2);
   ASSERT_TRUE(cut_path.advance({{1.0, Eigen::Vector3d::Zero(), 3 * h}, 0, 3 * h}).converged);
   EXPECT_EQ(faults, 1);
-  EXPECT_EQ(cut.state(), direct.state()); // displacement, velocity, acceleration, time: bit for bit
+  EXPECT_EQ(cut.state(), direct.state()); // displacement, velocity, acceleration, time (, damping): bit for bit
   EXPECT_EQ(cut.kinetic_energy(), direct.kinetic_energy());
   EXPECT_GT(direct.kinetic_energy(), 0.0);
+  EXPECT_EQ(cut.damping_dissipation(), direct.damping_dissipation());
+  if (eta > 0.0) {
+    EXPECT_GT(direct.damping_dissipation(), 0.0);
+  }
 }
+
+INSTANTIATE_TEST_SUITE_P(UndampedAndDamped, DynamicBarCutBack, ::testing::Values(0.0, 20.0));
 
 TEST(DynamicBar, RefusesAMaterialWithoutDensity) {
   FiniteStrainProblem p;

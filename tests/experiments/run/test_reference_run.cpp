@@ -146,7 +146,7 @@ TEST(ReferenceRun, ResumeFromACheckpointGivesTheUninterruptedProfile) {
 // The dynamic step's checkpoint carries the velocity and acceleration: a run resumed from it gives
 // the uninterrupted run's forces and kinetic energy bit for bit (without them the first resumed
 // step would start from rest and differ), and a quasi-static run's checkpoint is refused by a
-// dynamic run, naming the time integration.
+// dynamic run, naming the time integration; likewise a damped run's by an undamped one.
 TEST(ReferenceRun, DynamicResumeCarriesVelocityAndAcceleration) {
   const ClayPull c;
   ReferenceRunSettings s;
@@ -185,6 +185,21 @@ TEST(ReferenceRun, DynamicResumeCarriesVelocityAndAcceleration) {
     message = e.what();
   }
   EXPECT_NE(message.find("quasi-static run and this run is dynamic"), std::string::npos) << message;
+
+  // clay_pull has damping (10 Pa s): the dynamic run above is damped, its checkpoint carries the
+  // damping dissipation (in the resumed manifest bit for bit), and an undamped run refuses it.
+  EXPECT_TRUE(whole_manifest.at("model").at("parameters").at("kelvin_voigt_damping").get<bool>());
+  EXPECT_GT(whole_manifest.at("energy").at("damping_dissipation_J").get<double>(), 0.0);
+  EXPECT_EQ(m.at("energy").at("damping_dissipation_J"), whole_manifest.at("energy").at("damping_dissipation_J"));
+  ReferenceRunSettings undamped = s;
+  undamped.damping = false;
+  message.clear();
+  try {
+    run_reference(c.scene, c.mesh, undamped, dir);
+  } catch (const std::runtime_error& e) {
+    message = e.what();
+  }
+  EXPECT_NE(message.find("with the scene's Kelvin-Voigt damping and this run is undamped"), std::string::npos) << message;
 }
 
 // Fault injection (issue 10, docs/reliability.md): a NaN in the assembled residual of a Newton
