@@ -33,9 +33,57 @@ struct CellGradient {
   }
 };
 
+/// One spring's force on its start point p and its elastic energy: the spring from p to q.
+template <class Real>
+struct SpringForce {
+  Real x, y, z; ///< f_a [N]; the end point q takes −f_a
+  Real energy;  ///< ½ k (l − L)² [J]
+};
+
+/// The spring from lattice point p to q = p + o, with stiffness kp, in double precision on
+/// absolute positions X and velocities V (one plane per coordinate), the law of cell_forces
+/// (spring_network.cpp; paper 000 §2.1's springs, with the scene's Kelvin–Voigt damping time τ):
+///   f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l,  e = x_b − x_a,
+/// and no force (nor energy) when the ends coincide (l ≤ tiny: no direction).
+[[gnu::always_inline]] inline SpringForce<double> spring_force(int p, int q, double kp, double rest, double tau, double tiny,
+                                                               const double* __restrict X, const double* __restrict Y,
+                                                               const double* __restrict Z, const double* __restrict VX,
+                                                               const double* __restrict VY, const double* __restrict VZ) {
+  const double ex = X[q] - X[p], ey = Y[q] - Y[p], ez = Z[q] - Z[p];
+  const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
+  const double inv_l = l > tiny ? 1.0 / l : 0.0;
+  const double stretch = l - rest;
+  const double rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
+  const double scale = kp * (stretch + tau * rate * inv_l) * inv_l;
+  return {scale * ex, scale * ey, scale * ez, inv_l > 0.0 ? 0.5 * kp * stretch * stretch : 0.0};
+}
+
+/// The same spring in single precision on displacements from the lattice's rest positions
+/// (U = x − X, so that the spring vector e = h o_d + (U[q] − U[p]) keeps the displacement's
+/// digits, where single-precision absolute positions would lose them; (ox, oy, oz) = h o_d), with
+/// the stretch written without cancellation, l − L = (2 L_vec·Δu + |Δu|²) / (l + L).
+[[gnu::always_inline]] inline SpringForce<float> spring_force(int p, int q, float kp, float ox, float oy, float oz, float rest,
+                                                              float tau, float tiny, const float* __restrict UX,
+                                                              const float* __restrict UY, const float* __restrict UZ,
+                                                              const float* __restrict VX, const float* __restrict VY,
+                                                              const float* __restrict VZ) {
+  const float ux = UX[q] - UX[p], uy = UY[q] - UY[p], uz = UZ[q] - UZ[p];
+  const float ex = ox + ux, ey = oy + uy, ez = oz + uz;
+  const float l = std::sqrt(ex * ex + ey * ey + ez * ez);
+  // One division for both quotients: w = 1 / (l (l + L)), 1/l = (l + L) w, 1/(l + L) = l w.
+  const bool apart = l > tiny;
+  const float w = 1.0f / (apart ? l * (l + rest) : 1.0f);
+  const float inv_l = apart ? (l + rest) * w : 0.0f;
+  // l − L = (l² − L²)/(l + L),  l² − L² = 2 L_vec·Δu + |Δu|²
+  const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) * (l * w);
+  const float rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
+  const float scale = kp * (stretch + tau * rate * inv_l) * inv_l;
+  return {scale * ex, scale * ey, scale * ez, inv_l > 0.0f ? 0.5f * kp * stretch * stretch : 0.0f};
+}
+
 /// The springs of one lattice direction, from lattice points p in [begin, end) to p + o: adds
-/// each spring's force on its start point to F and stores it in G (the end point takes −G).
-/// Returns their elastic energy [J].
+/// each spring's force on its start point to F and stores it in G (the end point takes −G, in
+/// direction_ends). Returns their elastic energy [J].
 KERF_VECTOR_CLONES
 double direction_springs(int begin, int end, int o, double rest, double tau, double tiny, const double* __restrict k,
                          const double* __restrict X, const double* __restrict Y, const double* __restrict Z,
@@ -45,18 +93,10 @@ double direction_springs(int begin, int end, int o, double rest, double tau, dou
   double energy = 0.0;
 #pragma omp simd reduction(+ : energy)
   for (int p = begin; p < end; ++p) {
-    const int q = p + o;
-    const double ex = X[q] - X[p], ey = Y[q] - Y[p], ez = Z[q] - Z[p];
-    const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
-    const double inv_l = l > tiny ? 1.0 / l : 0.0; // coincident ends: no direction, no force
-    const double stretch = l - rest;
-    const double rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
-    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
-    const double scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
-    const double gx = scale * ex, gy = scale * ey, gz = scale * ez;
-    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
-    GX[p] = gx, GY[p] = gy, GZ[p] = gz;
-    energy += inv_l > 0.0 ? 0.5 * k[p] * stretch * stretch : 0.0;
+    const SpringForce<double> g = spring_force(p, p + o, k[p], rest, tau, tiny, X, Y, Z, VX, VY, VZ);
+    FX[p] += g.x, FY[p] += g.y, FZ[p] += g.z;
+    GX[p] = g.x, GY[p] = g.y, GZ[p] = g.z;
+    energy += g.energy;
   }
   return energy;
 }
@@ -74,18 +114,10 @@ double direction_springs_fused(int begin, int end, int o, double rest, double ta
   double energy = 0.0;
 #pragma omp simd reduction(+ : energy) safelen(8)
   for (int p = begin; p < end; ++p) {
-    const int q = p + o;
-    const double ex = X[q] - X[p], ey = Y[q] - Y[p], ez = Z[q] - Z[p];
-    const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
-    const double inv_l = l > tiny ? 1.0 / l : 0.0; // coincident ends: no direction, no force
-    const double stretch = l - rest;
-    const double rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
-    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
-    const double scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
-    const double gx = scale * ex, gy = scale * ey, gz = scale * ez;
-    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
-    FX[q] -= gx, FY[q] -= gy, FZ[q] -= gz;
-    energy += inv_l > 0.0 ? 0.5 * k[p] * stretch * stretch : 0.0;
+    const SpringForce<double> g = spring_force(p, p + o, k[p], rest, tau, tiny, X, Y, Z, VX, VY, VZ);
+    FX[p] += g.x, FY[p] += g.y, FZ[p] += g.z;
+    FX[p + o] -= g.x, FY[p + o] -= g.y, FZ[p + o] -= g.z;
+    energy += g.energy;
   }
   return energy;
 }
@@ -113,11 +145,8 @@ void direction_ends_single(int begin, int end, int o, const float* __restrict GX
   direction_ends_of(begin, end, o, GX, GY, GZ, FX, FY, FZ);
 }
 
-/// direction_springs in single precision on displacements from the lattice's rest positions
-/// (U = x − X, so that the spring vector e = h o_d + (U[q] − U[p]) keeps the displacement's
-/// digits, where single-precision absolute positions would lose them), with the stretch written
-/// without cancellation, l − L = (2 L_vec·Δu + |Δu|²) / (l + L). Forces into F (single), the
-/// end points' share into G; returns the elastic energy [J].
+/// direction_springs in single precision (spring_force on displacements U): forces into F
+/// (single), the end points' share into G; returns the elastic energy [J].
 KERF_VECTOR_CLONES
 float direction_springs_single(int begin, int end, int o, float ox, float oy, float oz, float rest, float tau, float tiny,
                                const float* __restrict k, const float* __restrict UX, const float* __restrict UY,
@@ -127,23 +156,10 @@ float direction_springs_single(int begin, int end, int o, float ox, float oy, fl
   float energy = 0.0f;
 #pragma omp simd reduction(+ : energy)
   for (int p = begin; p < end; ++p) {
-    const int q = p + o;
-    const float ux = UX[q] - UX[p], uy = UY[q] - UY[p], uz = UZ[q] - UZ[p];
-    const float ex = ox + ux, ey = oy + uy, ez = oz + uz;
-    const float l = std::sqrt(ex * ex + ey * ey + ez * ez);
-    // One division for both quotients: w = 1 / (l (l + L)), 1/l = (l + L) w, 1/(l + L) = l w.
-    const bool apart = l > tiny;
-    const float w = 1.0f / (apart ? l * (l + rest) : 1.0f);
-    const float inv_l = apart ? (l + rest) * w : 0.0f;
-    // l − L = (l² − L²)/(l + L),  l² − L² = 2 L_vec·Δu + |Δu|²
-    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) * (l * w);
-    const float rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
-    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
-    const float scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
-    const float gx = scale * ex, gy = scale * ey, gz = scale * ez;
-    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
-    GX[p] = gx, GY[p] = gy, GZ[p] = gz;
-    energy += inv_l > 0.0f ? 0.5f * k[p] * stretch * stretch : 0.0f;
+    const SpringForce<float> g = spring_force(p, p + o, k[p], ox, oy, oz, rest, tau, tiny, UX, UY, UZ, VX, VY, VZ);
+    FX[p] += g.x, FY[p] += g.y, FZ[p] += g.z;
+    GX[p] = g.x, GY[p] = g.y, GZ[p] = g.z;
+    energy += g.energy;
   }
   return energy;
 }
@@ -160,20 +176,10 @@ float direction_springs_single_fused(int begin, int end, int o, float ox, float 
   float energy = 0.0f;
 #pragma omp simd reduction(+ : energy) safelen(16)
   for (int p = begin; p < end; ++p) {
-    const int q = p + o;
-    const float ux = UX[q] - UX[p], uy = UY[q] - UY[p], uz = UZ[q] - UZ[p];
-    const float ex = ox + ux, ey = oy + uy, ez = oz + uz;
-    const float l = std::sqrt(ex * ex + ey * ey + ez * ez);
-    const bool apart = l > tiny;
-    const float w = 1.0f / (apart ? l * (l + rest) : 1.0f);
-    const float inv_l = apart ? (l + rest) * w : 0.0f;
-    const float stretch = (2.0f * (ox * ux + oy * uy + oz * uz) + (ux * ux + uy * uy + uz * uz)) * (l * w);
-    const float rate = (VX[q] - VX[p]) * ex + (VY[q] - VY[p]) * ey + (VZ[q] - VZ[p]) * ez;
-    const float scale = k[p] * (stretch + tau * rate * inv_l) * inv_l;
-    const float gx = scale * ex, gy = scale * ey, gz = scale * ez;
-    FX[p] += gx, FY[p] += gy, FZ[p] += gz;
-    FX[q] -= gx, FY[q] -= gy, FZ[q] -= gz;
-    energy += inv_l > 0.0f ? 0.5f * k[p] * stretch * stretch : 0.0f;
+    const SpringForce<float> g = spring_force(p, p + o, k[p], ox, oy, oz, rest, tau, tiny, UX, UY, UZ, VX, VY, VZ);
+    FX[p] += g.x, FY[p] += g.y, FZ[p] += g.z;
+    FX[p + o] -= g.x, FY[p + o] -= g.y, FZ[p + o] -= g.z;
+    energy += g.energy;
   }
   return energy;
 }

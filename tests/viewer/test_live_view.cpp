@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <vector>
@@ -47,6 +48,8 @@ std::filesystem::path trajectory_csv(const SampledTrajectory& t, const std::stri
   return file;
 }
 
+constexpr double servo_rate = 1000.0; ///< [Hz] every session's servo loop
+
 /// One session of `duration` s: a fresh model and replay device(s), the view on or off.
 LiveViewReport session(const std::string& scene_name, const std::string& model_name, double model_rate, bool view) {
   const Scene scene = read_scene(std::string(KERF_SCENES_DIR) + "/" + scene_name + ".toml");
@@ -60,7 +63,7 @@ LiveViewReport session(const std::string& scene_name, const std::string& model_n
     raw.push_back(devices.back().get());
   }
   LiveViewSettings s;
-  s.servo.rate = 1000.0;
+  s.servo.rate = servo_rate;
   s.servo.model_rate = model_rate;
   s.servo.duration = 1.5;
   s.servo.safety = {8.5, 1000.0, 0.1, 0.05};
@@ -97,11 +100,17 @@ LiveViewReport session(const std::string& scene_name, const std::string& model_n
 /// on the differences finds no excess); fails when they missed significantly more (p < 0.01: a
 /// view that makes the servo miss in nearly every session, or by far more in total); is skipped,
 /// saying so, when too few pairs differ for any outcome to be significant (at alpha = 0.01, at
-/// least 7 pairs must differ) — it could not have failed, so it does not pass.
+/// least 7 pairs must differ) — it could not have failed, so it does not pass. It is skipped too,
+/// saying so, when the model alone cannot keep the servo rate: when, in most view-less sessions,
+/// the longest servo tick (its own work, not the wake-up) is longer than the 1 ms period. Then
+/// the loop misses deadlines in every session with or without the view (a sanitizer build: the
+/// voxel tick takes 1.6-1.8 ms under ASan + UBSan, 20-35 overruns in each view-less session,
+/// docs/reliability.md), and the counts measure which process the two cores serve, not the view.
 void expect_no_overrun(const std::string& scene, const std::string& model, double model_rate) {
   constexpr int pairs = 10;
   constexpr double alpha = 0.01;
   std::vector<kerf::test::OverrunPair> counts;
+  std::vector<double> longest_tick_without_view;
   for (int pair = 0; pair < pairs; ++pair) {
     LiveViewReport off, on;
     if (pair % 2 == 0) {
@@ -129,9 +138,19 @@ void expect_no_overrun(const std::string& scene, const std::string& model, doubl
                 static_cast<unsigned long long>(on.blocked_snapshots), static_cast<unsigned long long>(on.frames_rendered),
                 on.mean_render_seconds * 1e3, on.servo.realtime.fifo ? "yes" : "no");
     counts.push_back({off.servo.timing.overruns, on.servo.timing.overruns});
+    longest_tick_without_view.push_back(off.servo.timing.tick.max());
   }
   std::uint64_t without = 0, with = 0;
   for (const auto& c : counts) without += c.without, with += c.with;
+  constexpr double period = 1.0 / servo_rate;
+  std::nth_element(longest_tick_without_view.begin(), longest_tick_without_view.begin() + pairs / 2,
+                   longest_tick_without_view.end());
+  const double median_longest_tick = longest_tick_without_view[pairs / 2];
+  if (median_longest_tick > period)
+    GTEST_SKIP() << "without the view the servo tick's own work already exceeds the " << period * 1e3
+                 << " ms period (median over the sessions of the longest tick " << median_longest_tick * 1e6
+                 << " us; " << without << " overruns without the view, " << with
+                 << " with it): the model cannot keep the rate in this build, so the overrun counter cannot judge the view";
   const kerf::test::OverrunComparison c = kerf::test::compare_overruns(counts, alpha);
   std::printf("%s/%s: %llu overruns in %d sessions without the view, %llu with it; %d pairs differ; one-sided "
               "sign-flip p = %.4f\n",
