@@ -5,14 +5,18 @@
 #include <cstdlib>
 #include <new>
 
+namespace {
+thread_local bool counting = false;
+} // namespace
+
 namespace kerf::test {
 std::atomic<long> allocations{0};
-thread_local bool counting = false;
+void set_counting(bool on) noexcept { counting = on; }
 } // namespace kerf::test
 
 namespace {
 void note_allocation() {
-  if (kerf::test::counting) kerf::test::allocations.fetch_add(1, std::memory_order_relaxed);
+  if (counting) kerf::test::allocations.fetch_add(1, std::memory_order_relaxed);
 }
 } // namespace
 
@@ -59,7 +63,20 @@ void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
-#if !defined(__SANITIZE_ADDRESS__) && defined(__GLIBC__)
+#if defined(__SANITIZE_ADDRESS__)
+// Under AddressSanitizer malloc is ASan's own: count every allocation it makes (the malloc family,
+// and the malloc under the operator new above, so each new-expression counts twice: the checks
+// are "none" and "at least one") through its allocation hook, installed before main.
+// (GCC ships no <sanitizer/allocator_interface.h>; the declaration is compiler-rt's, which both
+// GCC's libasan and clang's runtime export.)
+extern "C" int __sanitizer_install_malloc_and_free_hooks(void (*malloc_hook)(const volatile void*, std::size_t),
+                                                         void (*free_hook)(const volatile void*));
+namespace {
+void on_sanitizer_malloc(const volatile void*, std::size_t) { note_allocation(); }
+void on_sanitizer_free(const volatile void*) {}
+[[maybe_unused]] const int hooks_installed = __sanitizer_install_malloc_and_free_hooks(on_sanitizer_malloc, on_sanitizer_free);
+} // namespace
+#elif defined(__GLIBC__)
 // Eigen and C code allocate with malloc directly: count those too, through glibc's own entry
 // points (sanitizer builds intercept malloc themselves, so there only operator new is counted).
 extern "C" {

@@ -32,9 +32,9 @@ long allocations_while_viewed(ToolModel& model, const TetMesh& mesh, const std::
   for (std::size_t k = 0; k < samples; ++k) {
     for (std::size_t i = 0; i < t.size(); ++i) tools[i] = t[i].samples[std::min(k, t[i].samples.size() - 1)];
     const long start = kerf::test::allocations.load();
-    kerf::test::counting = true;
+    kerf::test::set_counting(true);
     viewed.step(tools, dt, forces);
-    kerf::test::counting = false;
+    kerf::test::set_counting(false);
     if (k >= warmup) counted += kerf::test::allocations.load() - start;
   }
   EXPECT_GE(viewed.frames_published(), samples);

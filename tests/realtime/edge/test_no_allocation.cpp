@@ -23,7 +23,7 @@
 #include <thread>
 #include <new>
 using kerf::test::allocations;
-using kerf::test::counting;
+using kerf::test::set_counting;
 
 using namespace kerf;
 
@@ -39,16 +39,16 @@ TEST(RealtimeContract, DiscreteEdgeModelStepAllocatesNothing) {
   DiscreteEdgeCuttingModel model(CollisionVoxels(mesh, 5e-4, {"layer_upper", "layer_lower"}), s);
 
   // Sanity check that the counter works at all (direct calls: a new-expression may be elided).
-  counting = true;
+  set_counting(true);
   ::operator delete(::operator new(16));
-  counting = false;
+  set_counting(false);
   ASSERT_GE(allocations.load(), 1);
   allocations = 0;
 
   ToolState tool;
   ForceSample out;
   long modes_seen = 0;
-  counting = true;
+  set_counting(true);
   for (int pass = 0; pass < 2; ++pass) {     // the second pass re-enters the cut
     for (int k = 0; k <= 30000; ++k) {        // approach, cut 14 mm, retreat, with a lateral wobble
       const double z = k <= 15000 ? 0.016 - 1e-6 * k : 0.001 + 1e-6 * (k - 15000);
@@ -58,7 +58,7 @@ TEST(RealtimeContract, DiscreteEdgeModelStepAllocatesNothing) {
       modes_seen |= 1L << static_cast<int>(out.mode);
     }
   }
-  counting = false;
+  set_counting(false);
   EXPECT_EQ(allocations.load(), 0);
   // no-contact, deformation-1, cutting, deformation-2 (the edge model has no rupture instant)
   EXPECT_EQ(modes_seen, 0b11011);
@@ -88,7 +88,7 @@ TEST(RealtimeContract, EdgeModelStepAllocatesNothingWhileTheGeometricCutRuns) {
   ToolState tool;
   ForceSample out;
   long steps_while_cutting = 0;
-  counting = true;
+  set_counting(true);
   for (int k = 0; k <= 17000; ++k) { // z from 16 mm to -1 mm, 1 um per step
     tool.position = {0.020, 0.0, 0.016 - 1e-6 * k};
     tool.velocity = {0.0, 0.0, -1e-3};
@@ -100,7 +100,7 @@ TEST(RealtimeContract, EdgeModelStepAllocatesNothingWhileTheGeometricCutRuns) {
     model.step({&tool, 1}, 1e-3, {&out, 1});
     if (busy && ++steps_while_cutting == 1000) release = true;
   }
-  counting = false;
+  set_counting(false);
   release = true;
   EXPECT_EQ(allocations.load(), 0);
   EXPECT_GE(steps_while_cutting, 1000);
@@ -123,7 +123,7 @@ TEST(RealtimeContract, ShapeFormingStepAllocatesNothingThroughCutHandOverAndPull
   std::array<ForceSample, 2> forces;
   tools[1].position = {0.008, 0.0, 0.022};
   allocations = 0;
-  counting = true;
+  set_counting(true);
   for (int k = 0; k <= 2200; ++k) {
     tools[0].position = {0.016, 0.0, 0.021 - 1e-5 * k};
     tools[0].velocity = {0.0, 0.0, -0.01};
@@ -137,7 +137,7 @@ TEST(RealtimeContract, ShapeFormingStepAllocatesNothingThroughCutHandOverAndPull
     tools[1].velocity = {0.0, 0.0, 0.01};
     model.step(tools, 1e-3, forces);
   }
-  counting = false;
+  set_counting(false);
   EXPECT_EQ(allocations.load(), 0);
   ASSERT_TRUE(staged) << model.edge().geometric_cut()->error();
   EXPECT_LT(forces[1].force.z(), 0.0); // the pull was rendered

@@ -15,7 +15,7 @@
 #include <new>
 
 using kerf::test::allocations;
-using kerf::test::counting;
+using kerf::test::set_counting;
 
 using namespace kerf;
 
@@ -34,16 +34,16 @@ TEST(RealtimeContract, FractureModelStepAllocatesNothing) {
   FractureCuttingModel model(mesh, s);
 
   // Sanity check that the counter works at all (direct calls: a new-expression may be elided).
-  counting = true;
+  set_counting(true);
   ::operator delete(::operator new(16));
-  counting = false;
+  set_counting(false);
   ASSERT_GE(allocations.load(), 1); // operator new, and the malloc under it where counted
   allocations = 0;
 
   ToolState tool;
   ForceSample out;
   long modes_seen = 0;
-  counting = true;
+  set_counting(true);
   for (int pass = 0; pass < 2; ++pass) {     // the second pass re-enters the crack
     for (int k = 0; k <= 30000; ++k) {        // approach, cut 14 mm, retreat, with a lateral wobble
       const double z = k <= 15000 ? 0.016 - 1e-6 * k : 0.001 + 1e-6 * (k - 15000);
@@ -52,7 +52,7 @@ TEST(RealtimeContract, FractureModelStepAllocatesNothing) {
       modes_seen |= 1L << static_cast<int>(out.mode);
     }
   }
-  counting = false;
+  set_counting(false);
   EXPECT_EQ(allocations.load(), 0);
   EXPECT_EQ(modes_seen, 0b11111); // every mode was exercised while counting
 }

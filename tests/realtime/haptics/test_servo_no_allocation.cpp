@@ -26,7 +26,7 @@
 #include <new>
 
 using kerf::test::allocations;
-using kerf::test::counting;
+using kerf::test::set_counting;
 
 using namespace kerf;
 
@@ -60,9 +60,9 @@ TEST(RealtimeContract, ServoTickAllocatesNothing) {
   ServoLoop loop(model, devices, settings, &recorder);
 
   // Sanity check that the counter works at all.
-  counting = true;
+  set_counting(true);
   ::operator delete(::operator new(16));
-  counting = false;
+  set_counting(false);
   ASSERT_GE(allocations.load(), 1);
   allocations = 0;
 
@@ -72,9 +72,9 @@ TEST(RealtimeContract, ServoTickAllocatesNothing) {
   for (int k = 1; k <= 1100; ++k) {
     std::this_thread::sleep_until(start + std::chrono::milliseconds(k));
     const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    counting = true;
+    set_counting(true);
     loop.tick(now, 0.0);
-    counting = false;
+    set_counting(false);
     ++ticks;
   }
   const long counted = allocations.load();

@@ -15,7 +15,7 @@
 #include <new>
 
 using kerf::test::allocations;
-using kerf::test::counting;
+using kerf::test::set_counting;
 
 using namespace kerf;
 
@@ -27,21 +27,21 @@ long allocations_while_stepping(SpringNetworkModel& model, int samples, Path pat
   std::vector<ForceSample> forces(tools.size());
   model.step(tools = path(0), 1e-3, forces); // first sample outside the count
   allocations = 0;
-  counting = true;
+  set_counting(true);
   for (int k = 1; k <= samples; ++k) {
     const std::vector<ToolState>& next = path(k);
     for (std::size_t t = 0; t < tools.size(); ++t) tools[t] = next[t];
     model.step(tools, 1e-3, forces);
   }
-  counting = false;
+  set_counting(false);
   return allocations.load();
 }
 } // namespace
 
 TEST(RealtimeContract, SpringNetworkStepAllocatesNothing) {
-  counting = true;
+  set_counting(true);
   ::operator delete(::operator new(16));
-  counting = false;
+  set_counting(false);
   ASSERT_GE(allocations.load(), 1);
 
   const TetMesh mesh = test::clay_pull_mesh();

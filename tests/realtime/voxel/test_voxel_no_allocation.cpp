@@ -15,7 +15,7 @@
 #include <new>
 
 using kerf::test::allocations;
-using kerf::test::counting;
+using kerf::test::set_counting;
 
 using namespace kerf;
 
@@ -24,22 +24,22 @@ TEST(RealtimeContract, VoxelModelStepAllocatesNothing) {
   VoxelSurfaceCuttingModel model(test::cube_surface(1 * mm, 20), test::sponge_setup());
 
   // Sanity check that the counter works at all (direct calls: a new-expression may be elided).
-  counting = true;
+  set_counting(true);
   ::operator delete(::operator new(16));
-  counting = false;
+  set_counting(false);
   ASSERT_GE(allocations.load(), 1);
   allocations = 0;
 
   long modes_seen = 0;
   const auto note = [&](const ToolState&, const ForceSample& f) { modes_seen |= 1L << static_cast<int>(f.mode); };
-  counting = true;
+  set_counting(true);
   for (int pass = 0; pass < 2; ++pass) { // the second pass re-enters the cut
     test::move(model, {0.1 * mm, 0, 1.1 * mm}, {0.1 * mm, 0, 0.6 * mm}, 1e-3, note);
     test::move(model, {0.1 * mm, 0, 0.6 * mm}, {0.9 * mm, 0.05 * mm, 0.5 * mm}, 1e-3, note);
     test::move(model, {0.9 * mm, 0.05 * mm, 0.5 * mm}, {0.9 * mm, 0.05 * mm, 0.5 * mm}, 1e-3, note); // press
     test::move(model, {0.9 * mm, 0.05 * mm, 0.5 * mm}, {0.9 * mm, 0.05 * mm, 1.1 * mm}, 1e-3, note);
   }
-  counting = false;
+  set_counting(false);
   EXPECT_EQ(allocations.load(), 0);
   EXPECT_GT(model.cut_advances(), 0);
   // no-contact, deformation-1, cutting, deformation-2 were all exercised while counting.
