@@ -69,6 +69,15 @@ echo "uninterrupted: $samples samples in $whole_s s (the solve $solve_s s)"
 # 2. SIGKILL at random points, then --resume (a fixed seed: the same kill times every run).
 RANDOM=2026
 kills=0
+# Waits (at most 10 min) until LOG shows a sample whose number matches NUMBER_REGEX, or PID ends.
+wait_for_sample() {
+  local number="$1" log="$2" pid="$3"
+  for _ in $(seq 1 30000); do
+    grep -Eq "sample $number/$samples " "$log" && return
+    kill -0 "$pid" 2> /dev/null || return
+    sleep 0.02
+  done
+}
 for attempt in $(seq 1 6); do
   "$kerf" reference coarse.toml --samples $samples -o killed --resume > "killed.$attempt.log" 2>&1 &
   pid=$!
@@ -79,18 +88,10 @@ for attempt in $(seq 1 6); do
     # [0, 0.1] x it, while five samples are still to go: the kill lands and the next run
     # resumes from the checkpoint.
     if [ "$attempt" -le 2 ]; then
-      for _ in $(seq 1 30000); do
-        grep -Eq "sample [0-9]+/$samples " "killed.$attempt.log" && break
-        kill -0 "$pid" 2> /dev/null || break
-        sleep 0.02
-      done
+      wait_for_sample "[0-9]+" "killed.$attempt.log" "$pid"
       delay=$($py -c "import sys; print(float(sys.argv[1]) * (0.02 + 0.4 * int(sys.argv[2]) / 32767.0))" "$solve_s" "$RANDOM")
     else
-      for _ in $(seq 1 6000); do
-        grep -Eq "sample ([6-9]|1[01])/$samples " "killed.$attempt.log" && break
-        kill -0 "$pid" 2> /dev/null || break
-        sleep 0.02
-      done
+      wait_for_sample "([6-9]|1[01])" "killed.$attempt.log" "$pid"
       delay=$($py -c "import sys; print(float(sys.argv[1]) * 0.1 * int(sys.argv[2]) / 32767.0)" "$solve_s" "$RANDOM")
     fi
     sleep "$delay"

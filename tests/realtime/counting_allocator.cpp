@@ -78,7 +78,8 @@ void on_sanitizer_free(const volatile void*) {}
 } // namespace
 #elif defined(__GLIBC__)
 // Eigen and C code allocate with malloc directly: count those too, through glibc's own entry
-// points (sanitizer builds intercept malloc themselves, so there only operator new is counted).
+// points (only malloc, calloc and realloc: the aligned family is not counted here, see
+// docs/reliability.md, session 18).
 extern "C" {
 void* __libc_malloc(std::size_t);
 void* __libc_calloc(std::size_t, std::size_t);
