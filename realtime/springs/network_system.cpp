@@ -1,6 +1,7 @@
 #include "realtime/springs/network_system.hpp"
 
 #include "realtime/springs/lattice_dissection.hpp"
+#include "realtime/springs/supernodal_cholesky.hpp"
 #include "realtime/springs/vector_clones.hpp"
 
 #include <cholmod.h>
@@ -8,7 +9,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstring>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -33,66 +33,6 @@ constexpr bool whole_inverted_block(int columns) { return columns <= 48; }
 constexpr std::ptrdiff_t panel_floats(int nscol, int nsrow, int c) {
   return 4 * static_cast<std::ptrdiff_t>(whole_inverted_block(nscol) ? panel_rows(nsrow - c)
                                                                       : panel_rows(nscol - c) + panel_rows(nsrow - nscol));
-}
-
-// CHOLMOD's numeric supernodal factorisation takes one temporary per call from SuiteSparse's
-// allocator (the dense update block of L->maxcsize entries, cholmod_super_numeric). To keep
-// `factorize` allocation-free, SuiteSparse's allocator hooks are wrapped once: while a thread
-// has a workspace lease armed (only inside NetworkSystem::factorize), allocations on that thread
-// are carved out of the lease's buffer; everywhere else, and on every other thread, the hooks
-// pass straight through to the allocator that was installed before.
-struct WorkspaceLease {
-  char* begin = nullptr;
-  std::size_t size = 0;
-  std::size_t used = 0;
-  int live = 0; ///< blocks handed out and not yet freed
-  [[nodiscard]] bool holds(const void* p) const {
-    const char* c = static_cast<const char*>(p);
-    return c >= begin && c < begin + size;
-  }
-};
-thread_local WorkspaceLease* t_lease = nullptr;
-
-struct Hooks {
-  void* (*malloc_func)(std::size_t);
-  void* (*calloc_func)(std::size_t, std::size_t);
-  void* (*realloc_func)(void*, std::size_t);
-  void (*free_func)(void*);
-};
-Hooks g_previous{};
-
-void* lease_take(std::size_t bytes) noexcept {
-  WorkspaceLease* lease = t_lease;
-  if (!lease) return nullptr;
-  const std::size_t start = (lease->used + 63) & ~static_cast<std::size_t>(63);
-  if (start + bytes > lease->size) return nullptr;
-  lease->used = start + bytes;
-  ++lease->live;
-  return lease->begin + start;
-}
-void* hook_malloc(std::size_t bytes) {
-  if (void* p = lease_take(bytes)) return p;
-  return g_previous.malloc_func(bytes);
-}
-void* hook_calloc(std::size_t count, std::size_t size) {
-  if (void* p = lease_take(count * size)) return std::memset(p, 0, count * size);
-  return g_previous.calloc_func(count, size);
-}
-void* hook_realloc(void* p, std::size_t bytes) {
-  if (t_lease && p && t_lease->holds(p)) { // move the block out of the lease (never on the hot path)
-    void* q = g_previous.malloc_func(bytes);
-    if (q) std::memcpy(q, p, std::min(bytes, static_cast<std::size_t>(t_lease->begin + t_lease->size - static_cast<char*>(p))));
-    --t_lease->live;
-    return q;
-  }
-  return g_previous.realloc_func(p, bytes);
-}
-void hook_free(void* p) {
-  if (t_lease && p && t_lease->holds(p)) {
-    --t_lease->live;
-    return;
-  }
-  g_previous.free_func(p);
 }
 
 // OpenBLAS (Debian's default BLAS, openblas-pthread) fans large BLAS calls out to its thread
@@ -126,40 +66,20 @@ public:
   SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
 };
 
-void install_lease_hooks() {
+/// Looks up OpenBLAS's thread-count calls once (absent with another BLAS).
+void find_blas_thread_calls() {
   static std::once_flag once;
   std::call_once(once, [] {
     g_blas_get_threads = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
     g_blas_set_threads = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
     if (!g_blas_get_threads || !g_blas_set_threads) g_blas_get_threads = nullptr, g_blas_set_threads = nullptr;
-    g_previous = {SuiteSparse_config.malloc_func, SuiteSparse_config.calloc_func, SuiteSparse_config.realloc_func,
-                  SuiteSparse_config.free_func};
-    SuiteSparse_config.malloc_func = hook_malloc;
-    SuiteSparse_config.calloc_func = hook_calloc;
-    SuiteSparse_config.realloc_func = hook_realloc;
-    SuiteSparse_config.free_func = hook_free;
   });
 }
-
-/// Arms a lease on this thread for the scope.
-class ArmedLease {
-public:
-  ArmedLease(std::vector<double>& buffer, WorkspaceLease& lease) : m_lease(lease) {
-    lease = WorkspaceLease{reinterpret_cast<char*>(buffer.data()), buffer.size() * sizeof(double), 0, 0};
-    t_lease = &lease;
-  }
-  ~ArmedLease() { t_lease = nullptr; }
-  ArmedLease(const ArmedLease&) = delete;
-  ArmedLease& operator=(const ArmedLease&) = delete;
-
-private:
-  WorkspaceLease& m_lease;
-};
 
 } // namespace
 
 NetworkSystem::NetworkSystem(SolvePrecision precision) : m_precision(precision) {
-  install_lease_hooks();
+  find_blas_thread_calls();
   m_common = new cholmod_common;
   cholmod_start(m_common);
   m_common->supernodal = CHOLMOD_SUPERNODAL;
@@ -179,6 +99,12 @@ NetworkSystem::~NetworkSystem() {
 
 void NetworkSystem::release() noexcept {
   if (m_factor) cholmod_free_factor(&m_factor, m_common);
+}
+
+SupernodalStructure NetworkSystem::supernodal_structure() const noexcept {
+  if (!m_factor || !m_factor->is_super) return {};
+  return {static_cast<int>(m_factor->n), static_cast<int>(m_factor->nsuper), static_cast<const int*>(m_factor->super),
+          static_cast<const int*>(m_factor->pi), static_cast<const int*>(m_factor->px), static_cast<const int*>(m_factor->s)};
 }
 
 double NetworkSystem::factor_entries() const {
@@ -321,13 +247,11 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   m_diagonal.assign(static_cast<std::size_t>(n), -1);
   for (int k = 0; k < n; ++k) m_diagonal[static_cast<std::size_t>(k)] = value_index(k, k);
 
-  // The lease for cholmod_super_numeric's temporary: its cholmod_dense header and L->maxcsize
-  // entries, with room for alignment.
-  m_update_buffer.assign(m_factor->maxcsize + (sizeof(cholmod_dense) + 256) / sizeof(double) + 1, 0.0);
   // The solve's workspaces: the rows below the tallest supernode, the widest supernode's dots;
   // single precision: the inverted blocks' panels (four columns each, rows from the panel's
   // first column down) and one column of a block in double.
   if (!m_factor->is_super) throw std::runtime_error("NetworkSystem: CHOLMOD did not choose a supernodal factor");
+  m_numeric.analyse(supernodal_structure());
   const int* pi = static_cast<const int*>(m_factor->pi);
   const int* super = static_cast<const int*>(m_factor->super);
   const bool single = m_precision == SolvePrecision::single_precision;
@@ -354,7 +278,7 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   m_solution_single.assign(single ? static_cast<std::size_t>(n) : 0, 0.0f);
   m_rows_single.assign(single ? widest + tallest + 32 : 0, 0.0f);
   m_rows_split = static_cast<int>(widest) + 16;
-  // One factorisation of the mass matrix: CHOLMOD sizes what it keeps in Common now.
+  // One factorisation of the mass matrix, which must succeed (positive lumped masses).
   assemble(net, net.rest, 1.0, 0.0);
   if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
   m_factorized = false;
@@ -676,27 +600,12 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
 
 bool NetworkSystem::factorize() noexcept {
   if (!m_factor) return m_factorized = dof_count() == 0;
-  cholmod_sparse a{};
-  a.nrow = a.ncol = static_cast<std::size_t>(m_matrix.rows());
-  a.nzmax = static_cast<std::size_t>(m_matrix.nonZeros());
-  a.p = m_matrix.outerIndexPtr();
-  a.i = m_matrix.innerIndexPtr();
-  a.x = m_matrix.valuePtr();
-  a.stype = -1;
-  a.itype = CHOLMOD_INT;
-  a.xtype = CHOLMOD_REAL;
-  a.dtype = CHOLMOD_DOUBLE;
-  a.sorted = 1;
-  a.packed = 1;
-  double beta[2] = {0.0, 0.0};
-  WorkspaceLease lease;
   {
     const SingleThreadedBlas single;
-    const ArmedLease armed(m_update_buffer, lease);
-    // LLᵀ = A, A already in the factor's order (cholmod_factorize would first build A(p,p)).
-    cholmod_super_numeric(&a, nullptr, beta, m_factor, m_common);
+    // LLᵀ = A, A already in the factor's order.
+    m_factorized = m_numeric.factorize(supernodal_structure(), {m_matrix.outerIndexPtr(), m_matrix.innerIndexPtr(), m_matrix.valuePtr()},
+                                       static_cast<double*>(m_factor->x));
   }
-  m_factorized = m_common->status == CHOLMOD_OK && lease.live == 0;
   if (m_factorized) {
     const double* lx = static_cast<const double*>(m_factor->x);
     // 1 / L_kk for the solves, from the double-precision diagonal.

@@ -1,13 +1,16 @@
 #pragma once
 // NetworkSystem: the sparse symmetric system A = w_m M + w_k K_T of a spring network over its
-// free degrees of freedom, assembled into a fixed pattern and factorised by CHOLMOD's supernodal
-// Cholesky (SuiteSparse; Chen, Davis, Hager & Rajamanickam, "CHOLMOD, supernodal sparse Cholesky
-// factorization and update/downdate", ACM TOMS 35(3), 2008). The fill-reducing ordering and the
-// symbolic analysis are done once per pattern (`rebuild`, which allocates); assembly, numeric
-// factorisation and solves then reuse them and allocate nothing, which the realtime `step`
-// needs (docs/spring-network.md, "Linear solver").
+// free degrees of freedom, assembled into a fixed pattern and factorised by a supernodal
+// Cholesky: CHOLMOD's symbolic analysis (SuiteSparse; Chen, Davis, Hager & Rajamanickam,
+// "CHOLMOD, supernodal sparse Cholesky factorization and update/downdate", ACM TOMS 35(3), 2008)
+// and kerf's own numeric phase on its structure (supernodal_cholesky.hpp: CHOLMOD's would
+// allocate inside libgomp). The fill-reducing ordering and the symbolic analysis are done once
+// per pattern (`rebuild`, which allocates); assembly, numeric factorisation and solves then
+// reuse them and allocate nothing, which the realtime `step` needs (docs/spring-network.md,
+// "Linear solver").
 
 #include "realtime/springs/spring_network.hpp"
+#include "realtime/springs/supernodal_cholesky.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
@@ -75,10 +78,9 @@ public:
 
   /// A = mass_weight M + stiffness_weight K_T(x) (K_T from cell_stiffness_matrix, lumped M).
   void assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double mass_weight, double stiffness_weight) noexcept;
-  /// Numeric supernodal LLᵀ of the assembled A on the analysed pattern (cholmod_super_numeric on
-  /// the matrix already in the factor's order, so no permuted copy is made; its one temporary,
-  /// the supernode update block, comes from a buffer this object keeps). False if A is not
-  /// positive definite.
+  /// Numeric supernodal LLᵀ of the assembled A on the analysed pattern (SupernodalCholesky on
+  /// the matrix already in the factor's order, OpenBLAS on one thread; allocation-free). False
+  /// if A is not positive definite.
   bool factorize() noexcept;
   /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized).
   /// Double precision: L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's
@@ -107,6 +109,8 @@ public:
 
 private:
   void release() noexcept;
+  /// The analysed factor's supernodes, rows and value layout (empty before `rebuild`).
+  [[nodiscard]] SupernodalStructure supernodal_structure() const noexcept;
   /// Index of entry (r, c) of the lower triangle in the matrix's values, or −1.
   [[nodiscard]] int value_index(int r, int c) const noexcept;
   /// The value slots of one cell's 24 x 24 entries from its current corners; false if one is
@@ -142,7 +146,7 @@ private:
   /// triangle's rows first, the rows below from m_rows_split).
   std::vector<float> m_solution_single, m_rows_single;
   int m_rows_split = 0;
-  std::vector<double> m_update_buffer; ///< CHOLMOD's supernode update workspace (see factorize)
+  SupernodalCholesky m_numeric; ///< the numeric factorisation's workspaces
   bool m_factorized = false;
   FillOrdering m_ordering = FillOrdering::amd;
 };
