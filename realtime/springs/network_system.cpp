@@ -1,10 +1,10 @@
 #include "realtime/springs/network_system.hpp"
 
+#include "realtime/springs/cholmod_view.hpp"
 #include "realtime/springs/lattice_dissection.hpp"
 #include "realtime/springs/supernodal_cholesky.hpp"
 #include "realtime/springs/vector_clones.hpp"
 
-#include <cholmod.h>
 #include <dlfcn.h>
 
 #include <algorithm>
@@ -162,22 +162,7 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   }
 
   // Ordering and symbolic analysis by CHOLMOD on the natural pattern.
-  const auto view = [](Matrix& m, int stype) {
-    cholmod_sparse s{};
-    s.nrow = s.ncol = static_cast<std::size_t>(m.rows());
-    s.nzmax = static_cast<std::size_t>(m.nonZeros());
-    s.p = m.outerIndexPtr();
-    s.i = m.innerIndexPtr();
-    s.x = m.valuePtr();
-    s.stype = stype;
-    s.itype = CHOLMOD_INT;
-    s.xtype = CHOLMOD_REAL;
-    s.dtype = CHOLMOD_DOUBLE;
-    s.sorted = 1;
-    s.packed = 1;
-    return s;
-  };
-  cholmod_sparse pattern = view(m_matrix, -1);
+  cholmod_sparse pattern = cholmod_view(m_matrix, -1);
   // Fill-reducing ordering: the lattice's geometric nested dissection (lattice_dissection.hpp;
   // a node and its shadow take their lattice point's rank, dofs of one point stay together)
   // against AMD, CHOLMOD keeping the one with the smaller factor. Both are deterministic; METIS

@@ -3,9 +3,9 @@
 // implementation of the same algorithm: the factor is unique, so the values must agree to
 // round-off), and the defining identity L Lᵀ = P A Pᵀ applied to vectors.
 
+#include "realtime/springs/cholmod_view.hpp"
 #include "realtime/springs/supernodal_cholesky.hpp"
 
-#include <cholmod.h>
 #include <gtest/gtest.h>
 
 #include <Eigen/SparseCore>
@@ -55,23 +55,6 @@ Sparse grid_matrix(int m, double shift, unsigned seed) {
   return a;
 }
 
-/// CHOLMOD's view of a compressed-column matrix (stype −1: lower triangle; 0: unsymmetric).
-cholmod_sparse view(Sparse& a, int stype) {
-  cholmod_sparse s{};
-  s.nrow = s.ncol = static_cast<std::size_t>(a.rows());
-  s.nzmax = static_cast<std::size_t>(a.nonZeros());
-  s.p = a.outerIndexPtr();
-  s.i = a.innerIndexPtr();
-  s.x = a.valuePtr();
-  s.stype = stype;
-  s.itype = CHOLMOD_INT;
-  s.xtype = CHOLMOD_REAL;
-  s.dtype = CHOLMOD_DOUBLE;
-  s.sorted = 1;
-  s.packed = 1;
-  return s;
-}
-
 /// A supernodal analysis of A (AMD ordering) kept with its CHOLMOD workspace.
 class Analysis {
 public:
@@ -81,7 +64,7 @@ public:
     common.nmethods = 1;
     common.method[0].ordering = CHOLMOD_AMD;
     common.print = 0;
-    cholmod_sparse a = view(lower, -1);
+    cholmod_sparse a = cholmod_view(lower, -1);
     factor = cholmod_analyze(&a, &common);
   }
   ~Analysis() {
@@ -116,29 +99,41 @@ Sparse permuted_lower(const Sparse& full, const int* perm) {
   return lower;
 }
 
-/// y = L x for a supernodal L stored as `s` says, values `lx`.
-Eigen::VectorXd apply_l(const SupernodalStructure& s, const std::vector<double>& lx, const Eigen::VectorXd& x) {
+/// The lower triangle of `full`, compressed.
+Sparse lower_triangle(const Sparse& full) {
+  Sparse lower = full.triangularView<Eigen::Lower>();
+  lower.makeCompressed();
+  return lower;
+}
+
+/// SupernodalCholesky on `lower` (in the factor's order) with fresh workspaces for `analysis`.
+bool factorize_fresh(const Analysis& analysis, Sparse& lower, SupernodalCholesky& cholesky) {
+  cholesky.analyse(analysis.structure());
+  std::vector<double> lx(analysis.factor->xsize);
+  return cholesky.factorize(analysis.structure(), {lower.outerIndexPtr(), lower.innerIndexPtr(), lower.valuePtr()}, lx.data());
+}
+
+/// y = L x, or y = Lᵀ x (`transposed`), for a supernodal L stored as `s` says, values `lx`.
+Eigen::VectorXd apply_factor(const SupernodalStructure& s, const std::vector<double>& lx, const Eigen::VectorXd& x, bool transposed) {
   Eigen::VectorXd y = Eigen::VectorXd::Zero(x.size());
   for (int sn = 0; sn < s.supernodes; ++sn) {
     const int nsrow = s.row_start[sn + 1] - s.row_start[sn];
     for (int j = s.super[sn]; j < s.super[sn + 1]; ++j) {
       const double* column = lx.data() + s.value_start[sn] + static_cast<std::ptrdiff_t>(j - s.super[sn]) * nsrow;
-      for (int k = j - s.super[sn]; k < nsrow; ++k) y[s.rows[s.row_start[sn] + k]] += column[k] * x[j];
+      for (int k = j - s.super[sn]; k < nsrow; ++k) {
+        const int i = s.rows[s.row_start[sn] + k]; // L_ij = column[k]
+        if (transposed)
+          y[j] += column[k] * x[i];
+        else
+          y[i] += column[k] * x[j];
+      }
     }
   }
   return y;
 }
-/// y = Lᵀ x.
-Eigen::VectorXd apply_lt(const SupernodalStructure& s, const std::vector<double>& lx, const Eigen::VectorXd& x) {
-  Eigen::VectorXd y = Eigen::VectorXd::Zero(x.size());
-  for (int sn = 0; sn < s.supernodes; ++sn) {
-    const int nsrow = s.row_start[sn + 1] - s.row_start[sn];
-    for (int j = s.super[sn]; j < s.super[sn + 1]; ++j) {
-      const double* column = lx.data() + s.value_start[sn] + static_cast<std::ptrdiff_t>(j - s.super[sn]) * nsrow;
-      for (int k = j - s.super[sn]; k < nsrow; ++k) y[j] += column[k] * x[s.rows[s.row_start[sn] + k]];
-    }
-  }
-  return y;
+/// L Lᵀ x.
+Eigen::VectorXd apply_llt(const SupernodalStructure& s, const std::vector<double>& lx, const Eigen::VectorXd& x) {
+  return apply_factor(s, lx, apply_factor(s, lx, x, true), false);
 }
 
 } // namespace
@@ -146,8 +141,7 @@ Eigen::VectorXd apply_lt(const SupernodalStructure& s, const std::vector<double>
 TEST(SupernodalCholesky, AgreesWithCholmodAndReproducesTheMatrix) {
   // 6³ points x 3 = 648 unknowns: supernodes from 1 to ~100 columns, many descendants each.
   Sparse full = grid_matrix(6, 0.5, 7u);
-  Sparse lower = full.triangularView<Eigen::Lower>();
-  lower.makeCompressed();
+  Sparse lower = lower_triangle(full);
   Analysis analysis(lower);
   ASSERT_NE(analysis.factor, nullptr);
   ASSERT_TRUE(analysis.factor->is_super);
@@ -155,7 +149,7 @@ TEST(SupernodalCholesky, AgreesWithCholmodAndReproducesTheMatrix) {
   ASSERT_GT(s.supernodes, 10);
 
   // CHOLMOD's numeric factorisation, as the reference.
-  cholmod_sparse a = view(lower, -1);
+  cholmod_sparse a = cholmod_view(lower, -1);
   ASSERT_TRUE(cholmod_factorize(&a, analysis.factor, &analysis.common));
   ASSERT_EQ(analysis.common.status, CHOLMOD_OK);
   const auto* cholmod_x = static_cast<const double*>(analysis.factor->x);
@@ -184,7 +178,7 @@ TEST(SupernodalCholesky, AgreesWithCholmodAndReproducesTheMatrix) {
     Eigen::VectorXd x(s.n);
     for (int k = 0; k < s.n; ++k) x[k] = normal(random);
     const Eigen::VectorXd ax = permuted_full * x;
-    const Eigen::VectorXd llx = apply_l(s, lx, apply_lt(s, lx, x));
+    const Eigen::VectorXd llx = apply_llt(s, lx, x);
     EXPECT_LT((llx - ax).norm(), 1e-13 * ax.norm());
   }
 
@@ -194,32 +188,27 @@ TEST(SupernodalCholesky, AgreesWithCholmodAndReproducesTheMatrix) {
   ASSERT_TRUE(cholesky.factorize(s, {permuted2.outerIndexPtr(), permuted2.innerIndexPtr(), permuted2.valuePtr()}, lx.data()));
   Eigen::VectorXd x = Eigen::VectorXd::Ones(s.n);
   Sparse permuted2_full = permuted2.selfadjointView<Eigen::Lower>();
-  EXPECT_LT((apply_l(s, lx, apply_lt(s, lx, x)) - permuted2_full * x).norm(), 1e-13 * (permuted2_full * x).norm());
+  EXPECT_LT((apply_llt(s, lx, x) - permuted2_full * x).norm(), 1e-13 * (permuted2_full * x).norm());
 }
 
 TEST(SupernodalCholesky, RefusesAnIndefiniteMatrixAndNamesTheColumn) {
   Sparse full = grid_matrix(4, 0.5, 3u);
-  Sparse lower = full.triangularView<Eigen::Lower>();
-  lower.makeCompressed();
+  Sparse lower = lower_triangle(full);
   Analysis analysis(lower);
-  const SupernodalStructure s = analysis.structure();
   Sparse permuted = permuted_lower(full, analysis.permutation());
   // A negative diagonal entry in the last column: positive definite leading minors up to n − 1,
   // then a negative pivot (the Schur complement of a positive definite A is positive, so
   // lowering A_nn by more than A_nn itself makes the last pivot negative).
-  const int last = s.n - 1;
+  const int last = static_cast<int>(full.rows()) - 1;
   permuted.coeffRef(last, last) = -permuted.coeff(last, last);
   SupernodalCholesky cholesky;
-  cholesky.analyse(s);
-  std::vector<double> lx(analysis.factor->xsize);
-  EXPECT_FALSE(cholesky.factorize(s, {permuted.outerIndexPtr(), permuted.innerIndexPtr(), permuted.valuePtr()}, lx.data()));
+  EXPECT_FALSE(factorize_fresh(analysis, permuted, cholesky));
   EXPECT_EQ(cholesky.failed_column(), last);
 }
 
 TEST(SupernodalCholesky, RefusesAnEntryOutsideTheAnalysedPattern) {
   Sparse full = grid_matrix(4, 0.5, 5u);
-  Sparse lower = full.triangularView<Eigen::Lower>();
-  lower.makeCompressed();
+  Sparse lower = lower_triangle(full);
   Analysis analysis(lower);
   const SupernodalStructure s = analysis.structure();
   // Find a (row, column) pair outside L's pattern and put an entry of A there.
@@ -236,7 +225,5 @@ TEST(SupernodalCholesky, RefusesAnEntryOutsideTheAnalysedPattern) {
   permuted.coeffRef(row, column) = 1e-3;
   permuted.makeCompressed();
   SupernodalCholesky cholesky;
-  cholesky.analyse(s);
-  std::vector<double> lx(analysis.factor->xsize);
-  EXPECT_FALSE(cholesky.factorize(s, {permuted.outerIndexPtr(), permuted.innerIndexPtr(), permuted.valuePtr()}, lx.data()));
+  EXPECT_FALSE(factorize_fresh(analysis, permuted, cholesky));
 }
