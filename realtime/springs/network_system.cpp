@@ -101,12 +101,6 @@ void NetworkSystem::release() noexcept {
   if (m_factor) cholmod_free_factor(&m_factor, m_common);
 }
 
-SupernodalStructure NetworkSystem::supernodal_structure() const noexcept {
-  if (!m_factor || !m_factor->is_super) return {};
-  return {static_cast<int>(m_factor->n), static_cast<int>(m_factor->nsuper), static_cast<const int*>(m_factor->super),
-          static_cast<const int*>(m_factor->pi), static_cast<const int*>(m_factor->px), static_cast<const int*>(m_factor->s)};
-}
-
 double NetworkSystem::factor_entries() const {
   if (!m_factor) return 0.0;
   return m_factor->is_super ? static_cast<double>(m_factor->xsize) : static_cast<double>(m_factor->nzmax);
@@ -236,7 +230,7 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   // single precision: the inverted blocks' panels (four columns each, rows from the panel's
   // first column down) and one column of a block in double.
   if (!m_factor->is_super) throw std::runtime_error("NetworkSystem: CHOLMOD did not choose a supernodal factor");
-  m_numeric.analyse(supernodal_structure());
+  m_numeric.analyse(supernodal_structure(*m_factor));
   const int* pi = static_cast<const int*>(m_factor->pi);
   const int* super = static_cast<const int*>(m_factor->super);
   const bool single = m_precision == SolvePrecision::single_precision;
@@ -588,7 +582,7 @@ bool NetworkSystem::factorize() noexcept {
   {
     const SingleThreadedBlas single;
     // LLᵀ = A, A already in the factor's order.
-    m_factorized = m_numeric.factorize(supernodal_structure(), {m_matrix.outerIndexPtr(), m_matrix.innerIndexPtr(), m_matrix.valuePtr()},
+    m_factorized = m_numeric.factorize(supernodal_structure(*m_factor), {m_matrix.outerIndexPtr(), m_matrix.innerIndexPtr(), m_matrix.valuePtr()},
                                        static_cast<double*>(m_factor->x));
   }
   if (m_factorized) {

@@ -109,8 +109,6 @@ public:
 
 private:
   void release() noexcept;
-  /// The analysed factor's supernodes, rows and value layout (empty before `rebuild`).
-  [[nodiscard]] SupernodalStructure supernodal_structure() const noexcept;
   /// Index of entry (r, c) of the lower triangle in the matrix's values, or −1.
   [[nodiscard]] int value_index(int r, int c) const noexcept;
   /// The value slots of one cell's 24 x 24 entries from its current corners; false if one is

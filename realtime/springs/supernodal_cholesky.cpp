@@ -22,11 +22,45 @@ namespace kerf {
 
 namespace {
 
-/// Puts descendant d on the list of the supernode that its row `next_row` belongs to.
-inline void link_descendant(int d, int next_row, const int* supernode_of, int* head, int* next) noexcept {
-  const int target = supernode_of[next_row];
-  next[d] = head[target];
-  head[target] = d;
+/// The left-looking traversal both phases share. For each supernode s in order: `start(s)`; then
+/// `update(s, d, first, inside)` for every descendant d, whose rows [first, inside) (offsets into
+/// d's rows) lie in s's columns and [first, end of d) are the rows from the first of them on;
+/// then `finish(s)`. Each descendant is kept on the list of the next supernode its rows reach
+/// (head / next; its next row in `position`). False, and the traversal stops, when `start` or
+/// `finish` says false.
+template <class Start, class Update, class Finish>
+bool left_looking(const SupernodalStructure& L, const int* supernode_of, int* head, int* next, int* position, Start start,
+                  Update update, Finish finish) {
+  const auto link = [&](int d, int next_row) { // d onto the list of the supernode of `next_row`
+    const int target = supernode_of[next_row];
+    next[d] = head[target];
+    head[target] = d;
+  };
+  std::fill(head, head + L.supernodes, -1);
+  for (int s = 0; s < L.supernodes; ++s) {
+    if (!start(s)) return false;
+    const int k2 = L.super[s + 1];
+    int d = head[s];
+    head[s] = -1;
+    while (d >= 0) {
+      const int after = next[d];
+      const int ndrow = L.row_start[d + 1] - L.row_start[d];
+      const int* drows = L.rows + L.row_start[d];
+      int inside = position[d];
+      while (inside < ndrow && drows[inside] < k2) ++inside;
+      update(s, d, position[d], inside);
+      position[d] = inside;
+      if (inside < ndrow) link(d, drows[inside]);
+      d = after;
+    }
+    if (!finish(s)) return false;
+    const int nscol = k2 - L.super[s];
+    if (L.row_start[s + 1] - L.row_start[s] > nscol) {
+      position[s] = nscol;
+      link(s, L.rows[L.row_start[s] + nscol]);
+    }
+  }
+  return true;
 }
 
 } // namespace
@@ -46,48 +80,33 @@ void SupernodalCholesky::analyse(const SupernodalStructure& L) {
   // The largest update block C (ndrow2 x ndrow1) over every (descendant, supernode) pair: the
   // numeric phase's traversal without the numbers.
   std::size_t largest = 0;
-  for (int s = 0; s < L.supernodes; ++s) {
-    const int k2 = L.super[s + 1];
-    int d = m_head[static_cast<std::size_t>(s)];
-    m_head[static_cast<std::size_t>(s)] = -1;
-    while (d >= 0) {
-      const int after = m_next[static_cast<std::size_t>(d)];
-      const int first = L.row_start[d] + m_position[static_cast<std::size_t>(d)], end = L.row_start[d + 1];
-      int inside = first;
-      while (inside < end && L.rows[inside] < k2) ++inside;
-      largest = std::max(largest, static_cast<std::size_t>(end - first) * static_cast<std::size_t>(inside - first));
-      m_position[static_cast<std::size_t>(d)] = inside - L.row_start[d];
-      if (inside < end) link_descendant(d, L.rows[inside], m_supernode_of.data(), m_head.data(), m_next.data());
-      d = after;
-    }
-    const int nscol = k2 - L.super[s], nsrow = L.row_start[s + 1] - L.row_start[s];
-    if (nsrow > nscol) {
-      m_position[static_cast<std::size_t>(s)] = nscol;
-      link_descendant(s, L.rows[L.row_start[s] + nscol], m_supernode_of.data(), m_head.data(), m_next.data());
-    }
-  }
+  left_looking(
+      L, m_supernode_of.data(), m_head.data(), m_next.data(), m_position.data(), [](int) { return true; },
+      [&](int, int d, int first, int inside) {
+        const int ndrow = L.row_start[d + 1] - L.row_start[d];
+        largest = std::max(largest, static_cast<std::size_t>(ndrow - first) * static_cast<std::size_t>(inside - first));
+      },
+      [](int) { return true; });
   m_update.assign(std::max<std::size_t>(largest, 1), 0.0);
 }
 
 bool SupernodalCholesky::factorize(const SupernodalStructure& L, const LowerCompressedColumns& a, double* lx) noexcept {
   m_failed_column = -1;
   if (m_supernode_of.size() != static_cast<std::size_t>(L.n) || m_head.size() != static_cast<std::size_t>(L.supernodes)) return false;
-  std::fill(m_head.begin(), m_head.end(), -1);
   int* map = m_map.data();
   int* relative = m_relative.data();
   double* update = m_update.data();
   static constexpr char lower = 'L', no = 'N', transposed = 'T', right = 'R';
   static constexpr double one = 1.0, zero = 0.0;
 
-  for (int s = 0; s < L.supernodes; ++s) {
-    const int k1 = L.super[s], k2 = L.super[s + 1], nscol = k2 - k1;
+  // 1. L_s ← A(rows(s), cols(s)).
+  const auto scatter_a = [&](int s) {
+    const int k1 = L.super[s], k2 = L.super[s + 1];
     const int* srows = L.rows + L.row_start[s];
     const int nsrow = L.row_start[s + 1] - L.row_start[s];
     double* ls = lx + L.value_start[s];
     for (int k = 0; k < nsrow; ++k) map[srows[k]] = k;
-
-    // 1. L_s ← A(rows(s), cols(s)).
-    std::fill(ls, ls + static_cast<std::ptrdiff_t>(nsrow) * nscol, 0.0);
+    std::fill(ls, ls + static_cast<std::ptrdiff_t>(nsrow) * (k2 - k1), 0.0);
     for (int j = k1; j < k2; ++j) {
       double* column = ls + static_cast<std::ptrdiff_t>(j - k1) * nsrow;
       for (int p = a.column_start[j]; p < a.column_start[j + 1]; ++p) {
@@ -97,37 +116,34 @@ bool SupernodalCholesky::factorize(const SupernodalStructure& L, const LowerComp
         column[k] = a.value[p];
       }
     }
-
-    // 2. L_s −= L_d L_dᵀ (restricted to rows(s) x cols(s)) for every descendant d.
-    int d = m_head[static_cast<std::size_t>(s)];
-    m_head[static_cast<std::size_t>(s)] = -1;
-    while (d >= 0) {
-      const int after = m_next[static_cast<std::size_t>(d)];
-      const int ndcol = L.super[d + 1] - L.super[d];
-      const int ndrow = L.row_start[d + 1] - L.row_start[d];
-      const int* drows = L.rows + L.row_start[d];
-      const int p = m_position[static_cast<std::size_t>(d)];
-      int inside = p;
-      while (inside < ndrow && drows[inside] < k2) ++inside;
-      const int ndrow1 = inside - p;   // d's rows in cols(s): C's columns
-      const int ndrow2 = ndrow - p;    // d's rows from the first in cols(s) on: C's rows
-      const int ndrow3 = ndrow2 - ndrow1;
-      const double* ld = lx + L.value_start[d] + p;
-      // C(0:ndrow1, 0:ndrow1) = L1 L1ᵀ (lower triangle), C(ndrow1:ndrow2, :) = L2 L1ᵀ.
-      dsyrk_(&lower, &no, &ndrow1, &ndcol, &one, ld, &ndrow, &zero, update, &ndrow2, 1, 1);
-      if (ndrow3 > 0) dgemm_(&no, &transposed, &ndrow3, &ndrow1, &ndcol, &one, ld + ndrow1, &ndrow, ld, &ndrow, &zero, update + ndrow1, &ndrow2, 1, 1);
-      for (int i = 0; i < ndrow2; ++i) relative[i] = map[drows[p + i]];
-      for (int j = 0; j < ndrow1; ++j) {
-        double* column = ls + static_cast<std::ptrdiff_t>(relative[j]) * nsrow;
-        const double* c = update + static_cast<std::ptrdiff_t>(j) * ndrow2;
-        for (int i = j; i < ndrow2; ++i) column[relative[i]] -= c[i];
-      }
-      m_position[static_cast<std::size_t>(d)] = inside;
-      if (inside < ndrow) link_descendant(d, drows[inside], m_supernode_of.data(), m_head.data(), m_next.data());
-      d = after;
+    return true;
+  };
+  // 2. L_s −= L_d L_dᵀ (restricted to rows(s) x cols(s)) for a descendant d.
+  const auto subtract_descendant = [&](int s, int d, int p, int inside) {
+    const int nsrow = L.row_start[s + 1] - L.row_start[s];
+    double* ls = lx + L.value_start[s];
+    const int ndcol = L.super[d + 1] - L.super[d];
+    const int ndrow = L.row_start[d + 1] - L.row_start[d];
+    const int* drows = L.rows + L.row_start[d];
+    const int ndrow1 = inside - p;   // d's rows in cols(s): C's columns
+    const int ndrow2 = ndrow - p;    // d's rows from the first in cols(s) on: C's rows
+    const int ndrow3 = ndrow2 - ndrow1;
+    const double* ld = lx + L.value_start[d] + p;
+    // C(0:ndrow1, 0:ndrow1) = L1 L1ᵀ (lower triangle), C(ndrow1:ndrow2, :) = L2 L1ᵀ.
+    dsyrk_(&lower, &no, &ndrow1, &ndcol, &one, ld, &ndrow, &zero, update, &ndrow2, 1, 1);
+    if (ndrow3 > 0) dgemm_(&no, &transposed, &ndrow3, &ndrow1, &ndcol, &one, ld + ndrow1, &ndrow, ld, &ndrow, &zero, update + ndrow1, &ndrow2, 1, 1);
+    for (int i = 0; i < ndrow2; ++i) relative[i] = map[drows[p + i]];
+    for (int j = 0; j < ndrow1; ++j) {
+      double* column = ls + static_cast<std::ptrdiff_t>(relative[j]) * nsrow;
+      const double* c = update + static_cast<std::ptrdiff_t>(j) * ndrow2;
+      for (int i = j; i < ndrow2; ++i) column[relative[i]] -= c[i];
     }
-
-    // 3. L_ss ← chol(L_ss); L_bs ← L_bs L_ss⁻ᵀ.
+  };
+  // 3. L_ss ← chol(L_ss); L_bs ← L_bs L_ss⁻ᵀ.
+  const auto factor_supernode = [&](int s) {
+    const int k1 = L.super[s], nscol = L.super[s + 1] - k1;
+    const int nsrow = L.row_start[s + 1] - L.row_start[s];
+    double* ls = lx + L.value_start[s];
     int info = 0;
     dpotrf_(&lower, &nscol, ls, &nsrow, &info, 1);
     if (info != 0) { // info > 0: the leading minor of order info is not positive definite
@@ -137,11 +153,11 @@ bool SupernodalCholesky::factorize(const SupernodalStructure& L, const LowerComp
     if (nsrow > nscol) {
       const int below = nsrow - nscol;
       dtrsm_(&right, &lower, &transposed, &no, &below, &nscol, &one, ls, &nsrow, ls + nscol, &nsrow, 1, 1, 1, 1);
-      m_position[static_cast<std::size_t>(s)] = nscol;
-      link_descendant(s, srows[nscol], m_supernode_of.data(), m_head.data(), m_next.data());
     }
-  }
-  return true;
+    return true;
+  };
+  return left_looking(L, m_supernode_of.data(), m_head.data(), m_next.data(), m_position.data(), scatter_a,
+                      subtract_descendant, factor_supernode);
 }
 
 } // namespace kerf

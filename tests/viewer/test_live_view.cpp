@@ -127,7 +127,7 @@ void expect_no_overrun(const std::string& scene, const std::string& model, doubl
     // next frame time), so n steps of dt publish at least n dt / (1/rate + dt) frames; at least
     // half of those are asked for, and two. Not a fixed count: under the sanitizers the spring
     // network's 100 Hz thread takes far longer than its period per step, its clock falls behind
-    // and a 1.5 s session publishes 5-9 frames (CI's sanitizer stage, session 19), where Release
+    // and a 1.5 s session publishes 5-10 frames (CI's sanitizer stage, session 19), where Release
     // publishes 81 (161 model steps).
     const double model_dt = 1.0 / (model_rate > 0.0 ? model_rate : servo_rate);
     const std::uint64_t model_steps = model_rate > 0.0 ? on.servo.model_steps : on.servo.timing.ticks;

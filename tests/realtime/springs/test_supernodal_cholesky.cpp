@@ -73,10 +73,7 @@ public:
   }
   Analysis(const Analysis&) = delete;
   Analysis& operator=(const Analysis&) = delete;
-  [[nodiscard]] SupernodalStructure structure() const {
-    return {static_cast<int>(factor->n), static_cast<int>(factor->nsuper), static_cast<const int*>(factor->super),
-            static_cast<const int*>(factor->pi), static_cast<const int*>(factor->px), static_cast<const int*>(factor->s)};
-  }
+  [[nodiscard]] SupernodalStructure structure() const { return supernodal_structure(*factor); }
   [[nodiscard]] const int* permutation() const { return static_cast<const int*>(factor->Perm); }
   cholmod_common common{};
   cholmod_factor* factor = nullptr;
