@@ -36,17 +36,23 @@ namespace kerf::cli {
 
 namespace {
 
+/// `kerf reference`'s default sample count (--samples).
+constexpr int default_reference_samples = 40;
+
 struct ReferenceOptions {
   std::string scene;
   std::string out;
   int degree = 1;
   int refine = 0;
-  int samples = 0; ///< 0 = every trajectory sample
+  /// Trajectory samples solved: N evenly spaced (first and last included), or "all". The default
+  /// is one a user can wait for on a scene's mesh (a few minutes on two cores), fine enough to
+  /// draw the force-travel curve.
+  std::string samples = std::to_string(default_reference_samples);
   double until = -1.0; ///< < 0: the whole trajectory; else only samples with t <= until [s]
   int levels = 0;      ///< 0: one run; >= 3: a convergence study over that many refinements
   std::string element_size; ///< overrides the scene's element size ("5 mm"); empty = the scene's
   bool resume = false;
-  std::string fracture = "off";
+  std::string fracture = "auto";
   double viscous_time = 0.0; ///< τ [s] of the cohesive law's viscous regularisation (0: none)
   bool dynamic = false;      ///< the dynamic (inertial) step instead of the quasi-static one
   bool no_damping = false;   ///< dynamic step: leave the scene's Kelvin–Voigt damping out
@@ -66,7 +72,7 @@ struct ReferenceOptions {
   if (static_cast<unsigned>(o.np) > std::thread::hardware_concurrency()) args.emplace_back("--oversubscribe");
   args.insert(args.end(), {program, "reference", o.scene, "--degree", std::to_string(o.degree), "--refine",
                            std::to_string(o.refine)});
-  if (o.samples > 0) args.insert(args.end(), {"--samples", std::to_string(o.samples)});
+  args.insert(args.end(), {"--samples", o.samples});
   if (o.until >= 0.0) args.insert(args.end(), {"--until", std::to_string(o.until)});
   if (o.levels > 0) args.insert(args.end(), {"--levels", std::to_string(o.levels)});
   if (!o.element_size.empty()) args.insert(args.end(), {"--element-size", o.element_size});
@@ -120,8 +126,18 @@ void run_reference_command(const ReferenceOptions& o) {
   settings.damping = !o.no_damping;
   settings.interface_error_relative = o.interface_tolerance;
   if (o.interface_tolerance == 0.0) settings.interface_error_floor = 0.0; // the control off
-  if (o.samples < 0) throw std::invalid_argument("--samples must be >= 1, got " + std::to_string(o.samples));
-  if (o.samples > 0 || o.until >= 0.0) {
+  int samples = 0; // 0: every sample
+  if (o.samples != "all") {
+    std::size_t used = 0;
+    try {
+      samples = std::stoi(o.samples, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != o.samples.size() || samples < 1)
+      throw std::invalid_argument("--samples: expected a count >= 1 or \"all\", got \"" + o.samples + "\"");
+  }
+  {
     if (scene.tools.empty()) throw std::invalid_argument("scene '" + scene.name + "' has no tool");
     const SampledTrajectory path = sample(scene.tools.front().trajectory);
     // Samples are in time order: the first `count` have t <= until.
@@ -131,14 +147,14 @@ void run_reference_command(const ReferenceOptions& o) {
       while (count < path.samples.size() && path.samples[count].time <= o.until + 1e-12) ++count;
       if (count == 0) throw std::invalid_argument("--until " + std::to_string(o.until) + " s is before the first sample");
     }
-    if (o.samples > 0) {
-      settings.sample_indices = reference_sample_indices(count, o.samples);
+    if (samples > 0 && static_cast<std::size_t>(samples) < count) {
+      settings.sample_indices = reference_sample_indices(count, samples);
     } else {
       for (std::size_t k = 0; k < count; ++k) settings.sample_indices.push_back(k);
     }
   }
   const auto begin = std::chrono::steady_clock::now();
-  const TetMesh mesh = scene_mesh(scene);
+  const TetMesh mesh = scene_mesh(scene, MeshPurpose::reference);
   if (o.levels > 0) {
     if (o.resume) throw std::invalid_argument("--resume does not apply to a convergence study (--levels)");
     const fs::path dir = o.out.empty() ? fs::path("runs") / read.name / "reference_convergence" : fs::path(o.out);
@@ -168,8 +184,8 @@ void add_reference_command(CLI::App& app) {
   cmd->add_option("--degree", options->degree, "finite element degree")->check(CLI::IsMember({1, 2}));
   cmd->add_option("--refine", options->refine, "global mesh refinements")->check(CLI::Range(0, 4));
   cmd->add_option("--samples", options->samples,
-                  "solve N evenly spaced trajectory samples, first and last included (default: every sample)")
-      ->check(CLI::PositiveNumber);
+                  "solve N evenly spaced trajectory samples, first and last included, or \"all\" (default " +
+                      std::to_string(default_reference_samples) + ")");
   cmd->add_option("--until", options->until, "solve only trajectory samples with t <= T seconds")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--levels", options->levels,
@@ -193,7 +209,8 @@ void add_reference_command(CLI::App& app) {
                   "run distributed on N MPI processes: re-launches this command under mpirun -np N")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--fracture", options->fracture,
-                  "cohesive fracture along the scene's cut_plane: off (default until Reference II is complete), auto (cutting/tearing scenes with σ_c and J_c), on")
+                  "cohesive fracture along the scene's cut_plane: auto (default: on for a scene that declares cutting or "
+                  "tearing and gives cohesive_strength and fracture_toughness), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_option("--cohesive-viscous-time", options->viscous_time,
                   "viscous regularisation of the cohesive law (Gao & Bower 2004): relaxation time TAU in seconds, "

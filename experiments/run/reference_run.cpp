@@ -1,6 +1,7 @@
 #include "experiments/run/reference_run.hpp"
 
 #include "experiments/run/reference_checkpoint.hpp"
+#include "experiments/run/scene_mesh.hpp"
 #include "experiments/trajectory/trajectory.hpp"
 #include "meshes/atomic_file.hpp"
 #include "meshes/surface_mesh.hpp"
@@ -53,52 +54,34 @@ Eigen::Vector3d position_at(const std::vector<Eigen::Vector3d>& p, const std::ve
 
 namespace {
 
-/// If the sphere `tool` (sampled at `positions`) starts touching the body, moves, and never moves
-/// towards it (it pulls away, or drags the surface along), ties it (paper 000 §2.1: it grasps the surface): adds the tie group `tie_name` of the `top`
-/// triangles under it and the prescribed displacement u = p(λ T) − p(0) (the tool displacement
-/// since contact, λ the load factor) to `p`, and returns the coupling. Otherwise returns nothing.
-std::optional<ReferenceToolCoupling> tie_stylus(const Scene& scene, const TetMesh& mesh, const Tool& tool,
-                                                const std::vector<Eigen::Vector3d>& positions,
-                                                const std::vector<double>& times, const std::string& tie_name,
-                                                FiniteStrainProblem& p) {
+/// Ties the sphere `tool` (sampled at `positions`) to the disc it grasps (paper 000 §2.1: the stylus
+/// grasps the surface), the physical surface `grasp_surface` of the mesh (scene_mesh: a region of
+/// the geometry, the same whatever the mesh): adds the tie group `tie_name` of its triangles and
+/// the prescribed displacement u = p(λ T) − p(0) (the tool displacement since its start, λ the load
+/// factor) to `p`, and returns the coupling. A grasping stylus must start touching the body.
+ReferenceToolCoupling tie_stylus(const Scene& scene, const TetMesh& mesh, const Tool& tool,
+                                 const std::vector<Eigen::Vector3d>& positions, const std::vector<double>& times,
+                                 const std::string& grasp_surface, const std::string& tie_name, FiniteStrainProblem& p) {
   const SurfaceQuery surface(boundary_surface(mesh));
   const SurfaceQuery::Closest first = surface.closest_point(positions.front());
-  const Eigen::Vector3d away = first.normal;
-  const bool touching = std::abs(first.signed_distance - tool.radius) <= 0.05 * tool.radius;
-  // It moves (away from the surface, or along it: clay_tear drags the top apart), never into it.
-  double travel = 0.0, inward = 0.0;
-  for (const Eigen::Vector3d& x : positions) {
-    travel = std::max(travel, (x - positions.front()).norm());
-    inward = std::max(inward, -(x - positions.front()).dot(away));
-  }
-  if (!(touching && travel > 0.0 && inward <= 1e-9 * travel)) return std::nullopt;
-
+  if (std::abs(first.signed_distance - tool.radius) > 0.05 * tool.radius)
+    throw std::invalid_argument("reference: scene '" + scene.name + "' (" + scene.file.string() + "): stylus '" + tool.name +
+                                "' grasps the surface (grasp_radius) but does not start touching it: its tip centre is " +
+                                std::to_string(first.signed_distance * 1e3) + " mm from the surface, expected its radius " +
+                                std::to_string(tool.radius * 1e3) + " mm");
   ReferenceToolCoupling c;
   c.kind = ReferenceToolCoupling::Kind::tied;
   c.contact_point = first.point;
-  const SurfaceGroup* top = mesh.find_surface_group("top");
-  if (top == nullptr)
-    throw std::invalid_argument("reference: scene '" + scene.name + "': the tied stylus '" + tool.name +
-                                "' needs a surface group 'top'");
-  auto within = [&](int node) { return (Eigen::Vector3d(mesh.nodes.row(node)) - c.contact_point).norm() <= tool.radius; };
-  for (int pass = 0; pass < 2 && c.tied_triangles.empty(); ++pass)
-    for (Eigen::Index f = 0; f < top->triangles.rows(); ++f) {
-      int inside = 0;
-      for (int k = 0; k < 3; ++k) inside += within(top->triangles(f, k)) ? 1 : 0;
-      if (pass == 0 ? inside == 3 : inside > 0) c.tied_triangles.push_back(static_cast<int>(f));
-    }
-  if (c.tied_triangles.empty())
-    throw std::invalid_argument("reference: scene '" + scene.name + "': no node of 'top' lies within the radius of stylus '" +
-                                tool.name + "' of its first contact point");
-  SurfaceGroup tie;
+  const SurfaceGroup* grasp = mesh.find_surface_group(grasp_surface);
+  if (grasp == nullptr)
+    throw std::invalid_argument("reference: scene '" + scene.name + "': the mesh has no surface '" + grasp_surface +
+                                "' for the disc stylus '" + tool.name + "' grasps (mesh the scene with scene_mesh)");
+  for (Eigen::Index f = 0; f < grasp->triangles.rows(); ++f) c.tied_triangles.push_back(static_cast<int>(f));
+  SurfaceGroup tie = *grasp;
   tie.name = tie_name;
-  tie.triangles.resize(static_cast<Eigen::Index>(c.tied_triangles.size()), 3);
   std::set<int> nodes;
-  for (std::size_t i = 0; i < c.tied_triangles.size(); ++i)
-    for (int k = 0; k < 3; ++k) {
-      tie.triangles(static_cast<Eigen::Index>(i), k) = top->triangles(c.tied_triangles[i], k);
-      nodes.insert(top->triangles(c.tied_triangles[i], k));
-    }
+  for (Eigen::Index f = 0; f < tie.triangles.rows(); ++f)
+    for (int k = 0; k < 3; ++k) nodes.insert(tie.triangles(f, k));
   c.tied_nodes = nodes.size();
   p.mesh.surface_groups.push_back(std::move(tie));
 
@@ -160,6 +143,7 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh) {
   }
 
   const bool several = scene.tools.size() > 1;
+  int grasping = 0; // the grasping styluses so far: the k-th grasps the surface "grasp<k>" (scene_mesh.hpp)
   for (std::size_t j = 0; j < scene.tools.size(); ++j) {
     const Tool& tool = scene.tools[j];
     ReferenceTool& rt = out.tools[j];
@@ -179,14 +163,14 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh) {
       continue;
     }
     const std::string tie_name = several ? "stylus_tie_" + tool.name : "stylus_tie";
-    if (const auto tied = tie_stylus(scene, mesh, tool, rt.positions, out.times, tie_name, p)) {
-      rt.coupling = *tied;
+    if (tool.grasp_radius) {
+      rt.coupling = tie_stylus(scene, mesh, tool, rt.positions, out.times, grasp_surface_name(++grasping), tie_name, p);
       continue;
     }
     if (several)
       throw std::invalid_argument("reference: scene '" + scene.name + "': stylus '" + tool.name +
-                                  "' does not grasp the surface (it must start touching it and never move towards "
-                                  "it); several tools are coupled only as tied styluses");
+                                  "' does not grasp the surface (no grasp_radius); several tools are coupled only "
+                                  "as styluses that grasp it");
     // A sphere that presses: penalty contact.
     reference::RigidToolShape shape;
     shape.kind = reference::RigidToolShape::Kind::sphere;

@@ -66,12 +66,12 @@ struct ReferenceRunSettings {
 struct ReferenceToolCoupling {
   enum class Kind {
     penalty, ///< frictionless penalty contact with the rigid tool (a blade, or a pressing sphere)
-    tied     ///< the surface nodes under the stylus move with it (paper 000 §2.1: "the vertices at
-             ///< the stylus tip fixed to the stylus"): a sphere that starts touching and moves away
+    tied     ///< the disc the stylus grasps moves with it (paper 000 §2.1: "the vertices at the stylus
+             ///< tip fixed to the stylus"): a sphere with a grasp radius (Tool::grasp_radius)
   };
   Kind kind = Kind::penalty;
   Eigen::Vector3d contact_point = Eigen::Vector3d::Zero(); ///< tied: the body point first touched [m]
-  std::vector<int> tied_triangles; ///< tied: rows of the `top` surface group tied to the stylus
+  std::vector<int> tied_triangles; ///< tied: rows of the grasp surface group (scene_mesh.hpp) tied to the stylus
   std::size_t tied_nodes = 0;      ///< tied: distinct mesh nodes of those triangles
   int boundary = -1; ///< tied: index of its tie in FiniteStrainProblem::displacement_boundaries
 };

@@ -12,6 +12,7 @@
 #include "realtime/springs/spring_network_model.hpp"
 #include "realtime/springs/torn_tet_mesh.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -190,7 +191,16 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
   setup.volume_term = settings.volume_term.value_or(true);
   setup.cells = settings.cells.value_or(setup.cells);
   setup.cell_size = settings.cell_size.value_or(0.0);
+  // The stylus grasps the scene's disc (Tool::grasp_radius a, the reference's region too): the
+  // network nodes within the ball through the disc's rim, |x − c| <= (a² + r²)^½ of the tip centre
+  // c (one tip radius r above the disc's centre); [models.springs] grasp_radius overrides it.
   setup.grasp_radius = settings.grasp_radius.value_or(0.0);
+  if (!settings.grasp_radius)
+    for (const Tool& t : scene.tools)
+      if (t.kind == Tool::Kind::sphere && t.grasp_radius) {
+        setup.grasp_radius = std::hypot(*t.grasp_radius, t.radius);
+        break;
+      }
   setup.tearing = scene.phenomena.contains(Phenomenon::tearing);
   setup.tensile_limit = setup.tearing ? settings.tensile_limit.value_or(m.cohesive_strength) : 0.0;
   for (const Support& s : scene.supports) setup.supports.push_back({s.surface, s.kind == Support::Kind::sliding});

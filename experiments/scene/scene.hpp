@@ -26,6 +26,11 @@ struct SceneGeometry {
   std::filesystem::path source;               ///< absolute path of the .geo, .stl or .msh
   std::map<std::string, double> parameters;   ///< .geo parameters, SI
   double element_size = 0.0;                  ///< target tetrahedron size [m] > 0
+  /// The element size the scene file gives [m] (0: as element_size). A run that meshes the scene at
+  /// another element size (a study's mesh level, `--element-size`) scales every size the mesh is
+  /// graded to (scene_mesh_parameters) by element_size / nominal_element_size, so that a level is
+  /// the same graded mesh, systematically refined.
+  double nominal_element_size = 0.0;
   double stl_scale = 1.0;                     ///< STL coordinates times this = metres
 };
 
@@ -70,6 +75,11 @@ struct Tool {
   Kind kind = Kind::blade;
   BladeShape blade;           ///< blade only
   double radius = 0.0;        ///< [m] > 0, sphere only
+  /// Sphere only: the stylus grasps the surface (paper 000 §2.1: "pulling up"; §2.2: tearing) over
+  /// the disc of this radius [m] > 0 centred under its tip at its start. The disc is a physical region
+  /// of the geometry (its mesh conforms to the rim), the same for the reference and every model
+  /// that grasps, whatever the mesh. Absent: the stylus presses (contact), it does not grasp.
+  std::optional<double> grasp_radius;
   TrajectorySpec trajectory;
 };
 

@@ -490,6 +490,7 @@ private:
       g.element_size = required_quantity(t, "element_size", Dimension::length);
       check(g.element_size > 0.0, t, "element_size", "a length > 0");
     }
+    g.nominal_element_size = g.element_size;
 
     if (const toml::node* n = t.find("parameters")) {
       if (g.kind != SceneGeometry::Kind::geo)
@@ -624,9 +625,11 @@ private:
         check(b.thickness > 0.0, t, "thickness", "a length > 0");
       } else if (kind == "sphere") {
         tool.kind = Tool::Kind::sphere;
-        allow_only(t, {"name", "kind", "radius", "trajectory"}, "a sphere tool");
+        allow_only(t, {"name", "kind", "radius", "grasp_radius", "trajectory"}, "a sphere tool");
         tool.radius = required_quantity(t, "radius", Dimension::length);
         check(tool.radius > 0.0, t, "radius", "a length > 0");
+        if ((tool.grasp_radius = optional_quantity(t, "grasp_radius", Dimension::length)))
+          check(*tool.grasp_radius > 0.0, t, "grasp_radius", "a length > 0");
       } else {
         wrong(*t.find("kind"), t, t.key("kind"), "\"blade\" or \"sphere\"");
       }

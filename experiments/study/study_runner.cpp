@@ -51,7 +51,7 @@ ForceProfile subsample(const ForceProfile& profile, const std::vector<std::size_
 ReferenceRunner finite_element_reference() {
   return [](const Scene& scene, const StudyReferenceSpec& spec, int level, const std::vector<std::size_t>& indices,
             const std::filesystem::path& dir) {
-    return run_reference(scene, scene_mesh(scene), study_reference_settings(spec, level, indices), dir);
+    return run_reference(scene, scene_mesh(scene, MeshPurpose::reference), study_reference_settings(spec, level, indices), dir);
   };
 }
 

@@ -7,6 +7,13 @@
 // that size, growing linearly to cut_far_size over cut_grading_distance (a gmsh Box field with a
 // transition layer; the caller's element size, Mesh.MeshSizeMax, caps it); 0 (the default) meshes
 // uniformly.
+// Optional grasp discs (a stylus that grasps the top face, paper 000 §2.1-2.2): with
+// grasp1_radius > 0 the top face holds a conformingly meshed disc of that radius centred at
+// (grasp1_x, grasp1_y), the physical surface `grasp1` (also part of `top`); grasp2_* likewise.
+// grasp_element_size > 0 grades the mesh to that size on each rim, growing linearly with the
+// distance d from it, s = grasp_element_size + grasp_size_growth d, up to the caller's element size
+// (a gmsh Distance field on the rims and a MathEval of it).
+// kerf sets these from the scene (experiments/run/scene_mesh.cpp); a .geo user may set them by hand.
 SetFactory("OpenCASCADE");
 
 DefineConstant[
@@ -16,7 +23,15 @@ DefineConstant[
   cut_normal = {0, Choices{0, 1}, Name "Parameters/cut_normal"},
   cut_element_size = {0, Min 0, Name "Parameters/cut_element_size"},
   cut_far_size = {0.002, Min 1e-9, Name "Parameters/cut_far_size"},
-  cut_grading_distance = {0.004, Min 0, Name "Parameters/cut_grading_distance"}
+  cut_grading_distance = {0.004, Min 0, Name "Parameters/cut_grading_distance"},
+  grasp1_radius = {0, Min 0, Name "Parameters/grasp1_radius"},
+  grasp1_x = {0, Name "Parameters/grasp1_x"},
+  grasp1_y = {0, Name "Parameters/grasp1_y"},
+  grasp2_radius = {0, Min 0, Name "Parameters/grasp2_radius"},
+  grasp2_x = {0, Name "Parameters/grasp2_x"},
+  grasp2_y = {0, Name "Parameters/grasp2_y"},
+  grasp_element_size = {0, Min 0, Name "Parameters/grasp_element_size"},
+  grasp_size_growth = {0.5, Min 0, Name "Parameters/grasp_size_growth"}
 ];
 // The cut plane sits mid-length (cut_normal 0) or on the centre line (cut_normal 1) by default.
 DefineConstant[
@@ -41,7 +56,27 @@ Else
   Box(2) = {0, cut_offset, 0, length, width / 2 - cut_offset, depth};
 EndIf
 // Fragmenting the two halves makes them share the cut face, so the mesh is conforming across it.
-parts() = BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; };
+// Grasp discs on the top face are fragmented in with them: the top face's mesh conforms to each rim.
+discs() = {};
+grasp_r[] = {grasp1_radius, grasp2_radius};
+grasp_x[] = {grasp1_x, grasp2_x};
+grasp_y[] = {grasp1_y, grasp2_y};
+For g In {0 : 1}
+  If (grasp_r[g] > 0)
+    If (grasp_x[g] - grasp_r[g] <= 0 || grasp_x[g] + grasp_r[g] >= length ||
+        grasp_y[g] - grasp_r[g] <= -width / 2 || grasp_y[g] + grasp_r[g] >= width / 2)
+      Error("rect_prism.geo: grasp%g disc (centre %g, %g, radius %g) must lie inside the top face", g + 1, grasp_x[g], grasp_y[g], grasp_r[g]);
+    EndIf
+    d = news; Disk(d) = {grasp_x[g], grasp_y[g], depth, grasp_r[g]};
+    discs() += {d};
+  EndIf
+EndFor
+If (#discs() == 0)
+  parts() = BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; };
+Else
+  parts() = BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Surface{discs()}; Delete; };
+EndIf
+parts() = Volume{:};
 
 // Selection tolerance: OpenCASCADE enlarges entity bounding boxes by its tolerance (~1e-7 m),
 // so eps must exceed that (1 um for a 1 mm body), and stay far below the distance between
@@ -59,6 +94,25 @@ sides() = Abs(sides());
 sides() -= support();
 sides() -= top();
 
+// Each grasp disc's faces (the cut plane may split a disc in two halves).
+grasp1() = {};
+grasp2() = {};
+For g In {0 : 1}
+  If (grasp_r[g] > 0)
+    faces() = Surface In BoundingBox{grasp_x[g] - grasp_r[g] - eps, grasp_y[g] - grasp_r[g] - eps, depth - eps,
+                                     grasp_x[g] + grasp_r[g] + eps, grasp_y[g] + grasp_r[g] + eps, depth + eps};
+    If (#faces() == 0)
+      Error("rect_prism.geo: the grasp%g disc's faces were not found (bounding-box tolerance eps = %g)", g + 1, eps);
+    EndIf
+    If (g == 0)
+      grasp1() = faces();
+    Else
+      grasp2() = faces();
+    EndIf
+  EndIf
+EndFor
+
+size_fields() = {};
 If (cut_element_size > 0)
   Field[1] = Box;
   Field[1].VIn = cut_element_size;
@@ -77,7 +131,27 @@ If (cut_element_size > 0)
   EndIf
   Field[1].ZMin = depth - cut_refine_depth;
   Field[1].ZMax = depth + eps;
-  Background Field = 1;
+  size_fields() += {1};
+EndIf
+If (grasp_element_size > 0 && #grasp1() + #grasp2() > 0)
+  rims() = Abs(Boundary{ Surface{grasp1(), grasp2()}; });
+  Field[2] = Distance;
+  Field[2].CurvesList = {rims()};
+  Field[2].NumPointsPerCurve = 200;
+  // Size s0 on the rim, growing linearly with the distance d from it, s = s0 + g d (g =
+  // grasp_size_growth), capped by the caller's element size (Mesh.MeshSizeMax).
+  Field[4] = MathEval;
+  Field[4].F = Sprintf("%.17g + %.17g * F2", grasp_element_size, grasp_size_growth);
+  size_fields() += {4};
+EndIf
+If (#size_fields() == 1)
+  Background Field = size_fields(0);
+ElseIf (#size_fields() > 1)
+  Field[10] = Min;
+  Field[10].FieldsList = {size_fields()};
+  Background Field = 10;
+EndIf
+If (#size_fields() > 0)
   Mesh.MeshSizeExtendFromBoundary = 0;
   Mesh.MeshSizeFromPoints = 0;
 EndIf
@@ -91,3 +165,9 @@ Physical Surface("support") = {support()};
 Physical Surface("top") = {top()};
 Physical Surface("cut_plane") = {cut()};
 Physical Surface("sides") = {sides()};
+If (#grasp1() > 0)
+  Physical Surface("grasp1") = {grasp1()};
+EndIf
+If (#grasp2() > 0)
+  Physical Surface("grasp2") = {grasp2()};
+EndIf

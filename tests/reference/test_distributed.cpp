@@ -17,6 +17,7 @@
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"
+#include "tests/experiments/run/grasp_on_box.hpp"
 #include "reference/finite_strain_solver.hpp"
 #include "reference/mpi_processes.hpp"
 #include "tests/reference/reference_test_meshes.hpp"
@@ -185,7 +186,8 @@ TEST(Distributed, FieldsArePiecesPerProcess) {
 /// samples: the profile of 2 processes is the serial one; rank 0 wrote the files.
 TEST(Distributed, ClayPullProfileMatchesSerial) {
   const Scene scene = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
-  const TetMesh mesh = box_tet_mesh(Eigen::Vector3d(0, -0.02, 0), Eigen::Vector3d(0.04, 0.02, 0.02), 4, 4, 2);
+  TetMesh mesh = box_tet_mesh(Eigen::Vector3d(0, -0.02, 0), Eigen::Vector3d(0.04, 0.02, 0.02), 4, 4, 2);
+  kerf::test::add_grasp_groups_to_box(scene, mesh);
   ReferenceRunSettings settings;
   settings.sample_indices = reference_sample_indices(sample(scene.tools.front().trajectory).samples.size(), 4);
   settings.write_fields = true;

@@ -8,6 +8,7 @@
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"
+#include "tests/experiments/run/grasp_on_box.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -23,7 +24,11 @@ namespace fs = std::filesystem;
 struct ClayPull {
   Scene scene = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
   // clay_pull.toml: 40 × 40 × 20 mm block, x in [0, 40], y centred, base z = 0.
-  TetMesh mesh = box_tet_mesh(Eigen::Vector3d(0, -0.02, 0), Eigen::Vector3d(0.04, 0.02, 0.02), 4, 4, 2);
+  TetMesh mesh = [this] {
+    TetMesh m = box_tet_mesh(Eigen::Vector3d(0, -0.02, 0), Eigen::Vector3d(0.04, 0.02, 0.02), 4, 4, 2);
+    test::add_grasp_groups_to_box(scene, m);
+    return m;
+  }();
   std::size_t samples = sample(scene.tools.front().trajectory).samples.size();
 };
 
@@ -81,7 +86,8 @@ TEST(ReferenceRun, ClayTearTwoTiedStylusesPullTheBlockApart) {
   const Scene scene = read_scene(fs::path(KERF_SCENES_DIR) / "clay_tear.toml");
   // clay_tear.toml: 60 × 20 × 20 mm block, x in [0, 60], y centred, base z = 0; 5 mm cells put a
   // node under each stylus.
-  const TetMesh mesh = box_tet_mesh(Eigen::Vector3d(0, -0.01, 0), Eigen::Vector3d(0.06, 0.01, 0.02), 12, 4, 2);
+  TetMesh mesh = box_tet_mesh(Eigen::Vector3d(0, -0.01, 0), Eigen::Vector3d(0.06, 0.01, 0.02), 12, 4, 2);
+  test::add_grasp_groups_to_box(scene, mesh);
   const ReferenceProblem rp = reference_problem(scene, mesh);
   ASSERT_EQ(rp.tools.size(), 2u);
   for (const ReferenceTool& t : rp.tools) EXPECT_EQ(t.coupling.kind, ReferenceToolCoupling::Kind::tied) << t.name;
