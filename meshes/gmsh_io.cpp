@@ -337,6 +337,19 @@ TetMesh mesh_geo(const fs::path& geo, const std::map<std::string, double>& param
   return extract_tet_mesh(geo.string(), TetOrientation::make_positive);
 }
 
+std::set<std::string> geo_parameter_names(const fs::path& geo) {
+  require_file(geo, ".geo");
+  GmshSession session(geo.string());
+  const std::string file = fs::absolute(geo).string();
+  try {
+    session.run("reading", [&] { gmsh::open(file); });
+  } catch (const MeshError&) {
+    // The DefineConstant blocks come first: their names are known even if the defaults alone make
+    // the geometry fail (see mesh_geo).
+  }
+  return declared_parameters();
+}
+
 TetMesh mesh_stl(const fs::path& stl, double element_size, double scale) {
   require_element_size(stl, element_size);
   if (!(scale > 0.0) || !std::isfinite(scale))

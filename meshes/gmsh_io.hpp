@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
 
 namespace kerf {
@@ -22,6 +23,10 @@ TetMesh mesh_geo(const std::filesystem::path& geo, const std::map<std::string, d
 /// Meshes the volume enclosed by a closed STL surface (a scan, say; coordinates in metres after
 /// multiplying by `scale`) with element size `element_size` [m]. The result has the physical
 /// volume `body` and the physical surface `boundary`.
+/// The names of the parameters `geo` declares (its DefineConstant blocks, ONELAB
+/// "Parameters/NAME"), read by opening it with its defaults. Throws MeshError if it cannot be read.
+std::set<std::string> geo_parameter_names(const std::filesystem::path& geo);
+
 TetMesh mesh_stl(const std::filesystem::path& stl, double element_size, double scale = 1.0);
 
 /// Reads a .msh file (any version gmsh reads) holding first-order tetrahedra and triangles.

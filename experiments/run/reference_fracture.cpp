@@ -2,12 +2,31 @@
 
 #include "meshes/crack_split.hpp"
 
+#include "experiments/trajectory/trajectory.hpp"
+
 #include <algorithm>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
 namespace kerf {
+
+CohesiveZone scene_cohesive_zone(const Scene& scene) {
+  CohesiveZone z;
+  const Material& m = scene.material;
+  if (!(m.cohesive_strength > 0.0 && m.fracture_toughness > 0.0)) return z;
+  z.rice = reference::cohesive_zone_length(m.youngs_modulus, m.poisson_ratio, m.fracture_toughness, m.cohesive_strength);
+  const double failure_opening = 2.0 * m.fracture_toughness / m.cohesive_strength; // bilinear law: δ_f = 2 J_c/σ_c
+  for (const Tool& t : scene.tools)
+    if (t.kind == Tool::Kind::blade) z.wedge = std::max(z.wedge, failure_opening / (2.0 * std::tan(0.5 * t.blade.wedge_angle)));
+  return z;
+}
+
+bool scene_has_cohesive_law(const Scene& scene) {
+  const bool fractures = scene.phenomena.contains(Phenomenon::cutting) || scene.phenomena.contains(Phenomenon::tearing);
+  return fractures && scene.material.cohesive_strength > 0.0 && scene.material.fracture_toughness > 0.0;
+}
 
 CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem& problem, ReferenceFracture mode,
                              int refinements, double viscous_time) {
@@ -46,24 +65,46 @@ CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem&
                           c = split.mesh.nodes.row(split.plus_faces(f, 2));
     info.interface_area += 0.5 * (b - a).cross(c - a).norm();
   }
-  info.zone_length = reference::cohesive_zone_length(scene.material.youngs_modulus, scene.material.poisson_ratio,
-                                                     scene.material.fracture_toughness, scene.material.cohesive_strength);
-  // The element size on the crack path: the scene's, or the finer size its geometry grades the cut
-  // plane to (rect_prism.geo's cut_element_size), halved by each refinement.
-  double crack_path_size = scene.geometry.element_size;
-  if (const auto graded = scene.geometry.parameters.find("cut_element_size");
-      graded != scene.geometry.parameters.end() && graded->second > 0.0)
-    crack_path_size = std::min(crack_path_size, graded->second);
-  info.element_size = crack_path_size / std::pow(2.0, refinements);
+  const CohesiveZone zone = scene_cohesive_zone(scene);
+  info.zone_length = zone.length();
+  // The element size where the crack runs, measured on the split mesh (whatever graded it).
+  const Tool* blade = nullptr;
+  for (const Tool& t : scene.tools)
+    if (t.kind == Tool::Kind::blade) blade = &t;
+  double lowest = -std::numeric_limits<double>::infinity(); // along the cutting direction c: how far the edge reaches
+  Eigen::Vector3d c = Eigen::Vector3d::UnitZ();
+  if (blade != nullptr) {
+    c = blade->blade.cutting_direction;
+    lowest = -std::numeric_limits<double>::infinity();
+    for (const ToolState& st : sample(blade->trajectory).samples) lowest = std::max(lowest, st.position.dot(c));
+  }
+  double edges = 0.0;
+  std::size_t count = 0;
+  for (Eigen::Index f = 0; f < split.plus_faces.rows(); ++f) {
+    Eigen::Vector3d v[3];
+    for (int j = 0; j < 3; ++j) v[j] = split.mesh.nodes.row(split.plus_faces(f, j)).transpose();
+    const Eigen::Vector3d centroid = (v[0] + v[1] + v[2]) / 3.0;
+    if (blade != nullptr && centroid.dot(c) > lowest + info.zone_length) continue; // beyond the blade's reach
+    for (int j = 0; j < 3; ++j) edges += (v[(j + 1) % 3] - v[j]).norm();
+    count += 3;
+  }
+  if (count == 0) // the blade reaches no crack triangle: the whole path
+    for (Eigen::Index f = 0; f < split.plus_faces.rows(); ++f)
+      for (int j = 0; j < 3; ++j, count += 1)
+        edges += (split.mesh.nodes.row(split.plus_faces(f, (j + 1) % 3)) - split.mesh.nodes.row(split.plus_faces(f, j))).norm();
+  info.element_size = (count > 0 ? edges / static_cast<double>(count) : 0.0) / std::pow(2.0, refinements);
   info.elements_in_zone = reference::elements_in_cohesive_zone(info.zone_length, info.element_size);
   if (info.elements_in_zone < reference::minimum_elements_in_cohesive_zone) {
-    char buf[512];
+    char buf[640];
     std::snprintf(buf, sizeof buf,
-                  "the mesh is too coarse for the cohesive zone: l_cz = %.3g mm (σ_c = %.3g MPa, J_c = %.3g J/m²) spans "
-                  "%.2f elements of %.3g mm, fewer than %.0f (Turon et al. 2007); refine (--refine) or grade the mesh "
-                  "near cut_plane, or the force and dissipation depend on the mesh",
-                  info.zone_length * 1e3, scene.material.cohesive_strength * 1e-6, scene.material.fracture_toughness,
-                  info.elements_in_zone, info.element_size * 1e3, reference::minimum_elements_in_cohesive_zone);
+                  "the mesh is too coarse for the cohesive zone: the zone of %.3g mm (Rice's l_cz = %.3g mm, the "
+                  "blade's wedge s_f = %.3g mm; σ_c = %.3g MPa, J_c = %.3g J/m²) spans %.2f elements of %.3g mm where "
+                  "the crack runs, fewer than %.0f (Turon et al. 2007); mesh the scene for the reference "
+                  "(scene_mesh, MeshPurpose::reference) or refine (--refine), or the force and dissipation depend on "
+                  "the mesh",
+                  info.zone_length * 1e3, zone.rice * 1e3, zone.wedge * 1e3, scene.material.cohesive_strength * 1e-6,
+                  scene.material.fracture_toughness, info.elements_in_zone, info.element_size * 1e3,
+                  reference::minimum_elements_in_cohesive_zone);
     info.warning = buf;
   }
   return info;

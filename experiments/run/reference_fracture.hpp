@@ -25,17 +25,38 @@ enum class ReferenceFracture {
   on         ///< always; an error if the scene cannot have it
 };
 
+/// The cohesive zone a crack path must resolve (docs/cohesive-fracture.md, "Steady cutting"):
+/// Rice's zone of a crack loaded from afar, l_cz = (9π/32) E' J_c/σ_c² (cohesive_zone.hpp), and,
+/// in front of a blade's wedge, the zone the wedge itself sets: its flanks open the crack faces by
+/// 2 s tan(θ/2) at a distance s behind the edge, which reaches the failure opening δ_f = 2 J_c/σ_c
+/// at s_f = δ_f / (2 tan(θ/2)). The longer of the two governs; a mesh resolves it with
+/// minimum_elements_in_cohesive_zone elements (Turon et al. 2007).
+struct CohesiveZone {
+  double rice = 0.0;  ///< l_cz [m]
+  double wedge = 0.0; ///< s_f [m]; 0 without a blade
+  double length() const { return rice > wedge ? rice : wedge; }
+};
+
+/// The zone of `scene`'s cohesive law and blade; both 0 when the scene gives no σ_c or J_c.
+CohesiveZone scene_cohesive_zone(const Scene& scene);
+
+/// Whether `scene` declares a way to come apart (cutting or tearing) and gives the cohesive law
+/// (cohesive_strength and fracture_toughness) that a reference crack path needs.
+bool scene_has_cohesive_law(const Scene& scene);
+
 /// What `add_crack_path` did.
 struct CrackPathInfo {
   bool active = false;
   std::size_t interface_triangles = 0; ///< crack triangles joined by the cohesive law
-  double zone_length = 0.0;           ///< l_cz [m] (reference/cohesive/cohesive_zone.hpp)
-  double element_size = 0.0;          ///< the element size on cut_plane after refinement [m]: the scene's, or its
-                                      ///< geometry's `cut_element_size` grading when that is finer
-  double elements_in_zone = 0.0;      ///< l_cz / h
+  double zone_length = 0.0;           ///< the governing zone [m] (CohesiveZone::length)
+  /// The element size where the crack runs [m]: the mean edge length of the crack path's triangles
+  /// in the blade's sweep (from the top down to the deepest point its edge reaches plus one zone
+  /// length; the whole path for a tear), measured on the mesh and halved by each refinement.
+  double element_size = 0.0;
+  double elements_in_zone = 0.0;      ///< zone_length / element_size
   double viscosity = 0.0;             ///< η [Pa s/m] of the law's viscous regularisation (0: none)
   double interface_area = 0.0;        ///< reference area of the crack path joined by the law [m^2]
-  std::string warning;                ///< non-empty when l_cz / h < 3 (Turon et al. 2007)
+  std::string warning;                ///< non-empty when the zone spans fewer than 3 elements (Turon et al. 2007)
 };
 
 /// If `mode` asks for it (see ReferenceFracture), splits `problem.mesh` along `cut_plane`

@@ -1,15 +1,54 @@
 #include "experiments/run/scene_mesh.hpp"
 
+#include "experiments/run/reference_fracture.hpp"
+#include "experiments/trajectory/trajectory.hpp"
 #include "meshes/gmsh_io.hpp"
 #include "meshes/mesh_error.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
 namespace kerf {
 
 std::string grasp_surface_name(int k) { return "grasp" + std::to_string(k); }
+
+namespace {
+
+/// The crack path's grading for a reference mesh (see scene_mesh.hpp): on a geometry that declares
+/// rect_prism.geo's `cut_element_size` grading, a cutting or tearing scene with a cohesive law gets
+/// elements of min(h0, zone / 3) on its cut plane (CohesiveZone, reference_fracture.hpp), from the
+/// top down to one zone length below the deepest point a blade's edge reaches (the whole depth for a
+/// tear), growing to the element size h at half the distance (cut_grading_distance), all scaled by
+/// `scale`. Nothing for a blade that does not cut downwards (the grading box grows from the top).
+void add_crack_path_grading(const Scene& scene, double nominal, double scale, std::map<std::string, double>& p) {
+  const SceneGeometry& g = scene.geometry;
+  if (g.kind != SceneGeometry::Kind::geo || !scene_has_cohesive_law(scene)) return;
+  const std::set<std::string> declared = geo_parameter_names(g.source);
+  if (declared.count("cut_element_size") == 0 || declared.count("cut_refine_depth") == 0) return;
+  const CohesiveZone zone = scene_cohesive_zone(scene);
+  const double size = std::min(nominal, zone.length() / reference::minimum_elements_in_cohesive_zone) * scale;
+  const double h = g.element_size;
+  if (!(size < h)) return; // the uniform mesh already resolves the zone
+  double refine_depth = -1.0; // < 0: the geometry's default (its whole depth)
+  for (const Tool& t : scene.tools) {
+    if (t.kind != Tool::Kind::blade) continue;
+    if (t.blade.cutting_direction.z() > -0.999) return; // not a downward cut: the box grading does not apply
+    const auto top = g.parameters.find("depth");
+    if (top == g.parameters.end() || declared.count("depth") == 0) return;
+    double lowest = std::numeric_limits<double>::infinity();
+    for (const ToolState& st : sample(t.trajectory).samples) lowest = std::min(lowest, st.position.z());
+    refine_depth = std::clamp(top->second - lowest + zone.length() * scale, size, top->second);
+  }
+  p["cut_element_size"] = size;
+  p["cut_far_size"] = h;
+  p["cut_grading_distance"] = (h - size) / 0.5; // the size grows by half the distance
+  if (refine_depth > 0.0) p["cut_refine_depth"] = refine_depth;
+}
+
+} // namespace
 
 std::map<std::string, double> scene_mesh_parameters(const Scene& scene, MeshPurpose purpose) {
   const SceneGeometry& g = scene.geometry;
@@ -39,6 +78,7 @@ std::map<std::string, double> scene_mesh_parameters(const Scene& scene, MeshPurp
     finest_rim = finest_rim > 0.0 ? std::min(finest_rim, rim) : rim;
   }
   if (purpose == MeshPurpose::reference && finest_rim > 0.0) p["grasp_element_size"] = finest_rim;
+  if (purpose == MeshPurpose::reference) add_crack_path_grading(scene, nominal, scale, p);
   return p;
 }
 

@@ -2,7 +2,8 @@
 // The scene's body as tetrahedra, meshed from the scene: its geometry file and element size, the
 // physical regions its tools define (the disc a stylus grasps), and — for the finite-element
 // reference — the grading the physics needs (fine at each grasp rim, where the traction of a tied
-// disc is singular), with no hand-edited .geo parameters.
+// disc is singular; on the crack path, where the cohesive zone needs three elements), with no
+// hand-edited .geo parameters.
 
 #include "experiments/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
@@ -27,7 +28,11 @@ inline constexpr double grasp_rim_elements_per_radius = 6.0;
 /// The .geo parameters kerf derives from `scene` for `purpose`, beside the scene file's own:
 /// - `grasp<k>_radius`, `grasp<k>_x`, `grasp<k>_y` (k = 1, 2 in tool order) for each sphere tool
 ///   with a grasp radius: the disc under its start position on the top face;
-/// - for the reference, `grasp_element_size` (see grasp_rim_elements_per_radius).
+/// - for the reference, `grasp_element_size` (see grasp_rim_elements_per_radius), and for a cutting
+///   or tearing scene with a cohesive law on a geometry that declares them, the crack path's grading
+///   `cut_element_size` = min(h0, zone / 3) (the cohesive zone with at least three elements, Turon
+///   et al. 2007; CohesiveZone in reference_fracture.hpp), `cut_far_size`, `cut_grading_distance`
+///   and `cut_refine_depth` (the blade's reach plus one zone).
 /// Every derived size is scaled by element_size / nominal_element_size, so that meshing the scene
 /// at another element size refines the whole graded mesh systematically. Throws
 /// std::invalid_argument for a grasping stylus on a geometry that is not a .geo, or for more than

@@ -3,6 +3,9 @@
 // (y, z) = (-base_width/2, 0), (base_width/2, 0), (0, depth): the apex line is on top.
 // Physical groups: volume `body`; surfaces `support` (z = 0), `top` (the two slanted faces),
 // `cut_plane` (internal, x = cut_offset), `sides` (the end faces x = 0 and x = length).
+// Optional grading of the crack path, as in rect_prism.geo: with cut_element_size > 0 the elements
+// within cut_element_size of the cut plane and above z = depth - cut_refine_depth have that size,
+// growing to cut_far_size over cut_grading_distance (a gmsh Box field; Mesh.MeshSizeMax caps it).
 SetFactory("OpenCASCADE");
 
 DefineConstant[
@@ -11,7 +14,13 @@ DefineConstant[
   depth = {0.017, Min 1e-6, Name "Parameters/depth"}
 ];
 DefineConstant[
-  cut_offset = {length / 2, Name "Parameters/cut_offset"}
+  cut_offset = {length / 2, Name "Parameters/cut_offset"},
+  cut_element_size = {0, Min 0, Name "Parameters/cut_element_size"},
+  cut_far_size = {0.002, Min 1e-9, Name "Parameters/cut_far_size"},
+  cut_grading_distance = {0.004, Min 0, Name "Parameters/cut_grading_distance"}
+];
+DefineConstant[
+  cut_refine_depth = {depth, Min 0, Name "Parameters/cut_refine_depth"}
 ];
 If (cut_offset <= 0 || cut_offset >= length)
   Error("tri_prism.geo: cut_offset = %g must lie in (0, length = %g)", cut_offset, length);
@@ -50,6 +59,22 @@ top() -= sides();
 
 If (#support() == 0 || #top() == 0 || #cut() == 0 || #sides() == 0)
   Error("tri_prism.geo: a physical group selection came out empty (bounding-box tolerance eps = %g)", eps);
+EndIf
+
+If (cut_element_size > 0)
+  Field[1] = Box;
+  Field[1].VIn = cut_element_size;
+  Field[1].VOut = cut_far_size;
+  Field[1].Thickness = cut_grading_distance;
+  Field[1].XMin = cut_offset - cut_element_size;
+  Field[1].XMax = cut_offset + cut_element_size;
+  Field[1].YMin = -base_width / 2 - eps;
+  Field[1].YMax = base_width / 2 + eps;
+  Field[1].ZMin = depth - cut_refine_depth;
+  Field[1].ZMax = depth + eps;
+  Background Field = 1;
+  Mesh.MeshSizeExtendFromBoundary = 0;
+  Mesh.MeshSizeFromPoints = 0;
 EndIf
 
 Physical Volume("body") = {parts()};
