@@ -78,21 +78,21 @@ CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem&
     lowest = -std::numeric_limits<double>::infinity();
     for (const ToolState& st : sample(blade->trajectory).samples) lowest = std::max(lowest, st.position.dot(c));
   }
-  double edges = 0.0;
+  // The representative size of the triangles there: the side of the equilateral triangle of their
+  // mean area, h = (4 Ā / √3)^½ (the surface analogue of Celik et al. 2008's h = (V/N)^⅓).
+  double area = 0.0;
   std::size_t count = 0;
-  for (Eigen::Index f = 0; f < split.plus_faces.rows(); ++f) {
-    Eigen::Vector3d v[3];
-    for (int j = 0; j < 3; ++j) v[j] = split.mesh.nodes.row(split.plus_faces(f, j)).transpose();
-    const Eigen::Vector3d centroid = (v[0] + v[1] + v[2]) / 3.0;
-    if (blade != nullptr && centroid.dot(c) > lowest + info.zone_length) continue; // beyond the blade's reach
-    for (int j = 0; j < 3; ++j) edges += (v[(j + 1) % 3] - v[j]).norm();
-    count += 3;
-  }
-  if (count == 0) // the blade reaches no crack triangle: the whole path
-    for (Eigen::Index f = 0; f < split.plus_faces.rows(); ++f)
-      for (int j = 0; j < 3; ++j, count += 1)
-        edges += (split.mesh.nodes.row(split.plus_faces(f, (j + 1) % 3)) - split.mesh.nodes.row(split.plus_faces(f, j))).norm();
-  info.element_size = (count > 0 ? edges / static_cast<double>(count) : 0.0) / std::pow(2.0, refinements);
+  for (int pass = 0; pass < 2 && count == 0; ++pass) // pass 1: the whole path, when the blade reaches none of it
+    for (Eigen::Index f = 0; f < split.plus_faces.rows(); ++f) {
+      Eigen::Vector3d v[3];
+      for (int j = 0; j < 3; ++j) v[j] = split.mesh.nodes.row(split.plus_faces(f, j)).transpose();
+      const Eigen::Vector3d centroid = (v[0] + v[1] + v[2]) / 3.0;
+      if (pass == 0 && blade != nullptr && centroid.dot(c) > lowest + info.zone_length) continue; // beyond the blade's reach
+      area += 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).norm();
+      ++count;
+    }
+  const double mean_area = count > 0 ? area / static_cast<double>(count) : 0.0;
+  info.element_size = std::sqrt(4.0 * mean_area / std::sqrt(3.0)) / std::pow(2.0, refinements);
   info.elements_in_zone = reference::elements_in_cohesive_zone(info.zone_length, info.element_size);
   if (info.elements_in_zone < reference::minimum_elements_in_cohesive_zone) {
     char buf[640];

@@ -49,8 +49,8 @@ struct CrackPathInfo {
   bool active = false;
   std::size_t interface_triangles = 0; ///< crack triangles joined by the cohesive law
   double zone_length = 0.0;           ///< the governing zone [m] (CohesiveZone::length)
-  /// The element size where the crack runs [m]: the mean edge length of the crack path's triangles
-  /// in the blade's sweep (from the top down to the deepest point its edge reaches plus one zone
+  /// The element size where the crack runs [m]: the side of the equilateral triangle of the mean
+  /// area of the crack path's triangles in the blade's sweep (from the top down to the deepest point its edge reaches plus one zone
   /// length; the whole path for a tear), measured on the mesh and halved by each refinement.
   double element_size = 0.0;
   double elements_in_zone = 0.0;      ///< zone_length / element_size
