@@ -1,6 +1,6 @@
 // kerf reference SCENE [--degree 1|2] [--refine K] [--samples N] [--until T] [--levels L]
 // [--element-size H] [-o DIR] [--resume] [--no-fields] [--solver auto|direct|iterative] [--np N]
-// [--fracture auto|on|off] [--cohesive-viscous-time TAU] [--dynamic] [--no-damping]
+// [--fracture auto|on|off] [--adaptive F] [--min-travel MM] [--cohesive-viscous-time TAU] [--dynamic] [--no-damping]
 // [--interface-energy-tolerance REL]: the finite-strain reference along the
 // scene's trajectory (issue 3),
 // written as profile.csv + manifest.json (+ fields.pvd), with a progress line per sample and
@@ -53,6 +53,8 @@ struct ReferenceOptions {
   std::string element_size; ///< overrides the scene's element size ("5 mm"); empty = the scene's
   bool resume = false;
   std::string fracture = "auto";
+  double adaptive = 0.05;      ///< adaptive sampling: the force change (fraction of the peak) that inserts a sample; 0: off
+  double min_travel_mm = 0.05; ///< adaptive sampling: the least tool travel between two samples [mm]
   double viscous_time = 0.0; ///< τ [s] of the cohesive law's viscous regularisation (0: none)
   bool dynamic = false;      ///< the dynamic (inertial) step instead of the quasi-static one
   bool no_damping = false;   ///< dynamic step: leave the scene's Kelvin–Voigt damping out
@@ -77,6 +79,7 @@ struct ReferenceOptions {
   if (o.levels > 0) args.insert(args.end(), {"--levels", std::to_string(o.levels)});
   if (!o.element_size.empty()) args.insert(args.end(), {"--element-size", o.element_size});
   args.insert(args.end(), {"--fracture", o.fracture});
+  args.insert(args.end(), {"--adaptive", std::to_string(o.adaptive), "--min-travel", std::to_string(o.min_travel_mm)});
   if (o.viscous_time > 0.0) args.insert(args.end(), {"--cohesive-viscous-time", std::to_string(o.viscous_time)});
   if (o.dynamic) args.emplace_back("--dynamic");
   if (o.no_damping) args.emplace_back("--no-damping");
@@ -122,6 +125,8 @@ void run_reference_command(const ReferenceOptions& o) {
   settings.linear_solver = o.solver;
   settings.fracture = o.fracture == "on" ? ReferenceFracture::on : o.fracture == "off" ? ReferenceFracture::off : ReferenceFracture::automatic;
   settings.cohesive_viscous_time = o.viscous_time;
+  settings.adaptive_force_change = o.samples == "all" ? 0.0 : o.adaptive; // every sample: nothing to insert
+  settings.adaptive_min_travel = o.min_travel_mm * 1e-3;
   settings.dynamic = o.dynamic;
   settings.damping = !o.no_damping;
   settings.interface_error_relative = o.interface_tolerance;
@@ -212,6 +217,14 @@ void add_reference_command(CLI::App& app) {
                   "cohesive fracture along the scene's cut_plane: auto (default: on for a scene that declares cutting or "
                   "tearing and gives cohesive_strength and fracture_toughness), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
+  cmd->add_option("--adaptive", options->adaptive,
+                  "adaptive sampling: where the force changes by more than this fraction of its peak between two "
+                  "samples, or the interaction mode changes (contact, rupture, cutting), solve the sample half way "
+                  "first, down to --min-travel (default 0.05; 0: only the --samples)")
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--min-travel", options->min_travel_mm,
+                  "adaptive sampling: the least tool travel between two samples, in mm (default 0.05)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--cohesive-viscous-time", options->viscous_time,
                   "viscous regularisation of the cohesive law (Gao & Bower 2004): relaxation time TAU in seconds, "
                   "eta = sigma_c TAU / delta_f (default 0: none); its dissipation is in the manifest's energy")

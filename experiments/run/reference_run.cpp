@@ -283,8 +283,12 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
   std::optional<std::size_t> resumed_from;
   if (settings.resume && fs::exists(checkpoint_file)) {
     ReferenceCheckpoint saved = read_reference_checkpoint(checkpoint_file);
+    // An adaptive run's list grows by the samples it inserted: every requested one must be in it.
+    const bool same_samples = settings.adaptive_force_change > 0.0
+                                  ? std::includes(saved.indices.begin(), saved.indices.end(), indices.begin(), indices.end())
+                                  : saved.indices == indices;
     if (saved.scene_sha256 != sha || saved.degree != settings.degree || saved.refinements != settings.refinements ||
-        saved.indices != indices || saved.processes != cp.processes)
+        !same_samples || saved.processes != cp.processes)
       throw std::runtime_error("reference: " + checkpoint_file.string() +
                                " is from a different run (scene file, degree, refinements, samples or MPI process "
                                "count differ; it was written by " +
@@ -302,6 +306,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                                ": resume with the same damping");
     solver.set_state(saved.state);
     cp = std::move(saved);
+    indices = cp.indices; // an adaptive run continues with the samples it had inserted
     cp.last.time = cp.last.load_factor * T; // the load factor is t/T (load_of), also between samples
     resumed_from = cp.solved;
     if (writer)
@@ -320,8 +325,10 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     path_settings.interface_error_absolute =
         settings.interface_error_floor * scene.material.fracture_toughness * crack.interface_area;
   }
-  reference::LoadPath path(solver, cp.last, path_settings);
-  path.set_interface_step(cp.interface_step);
+  // In an optional: adaptive sampling rebuilds it at an earlier converged state (it holds the solver).
+  std::optional<reference::LoadPath> load_path;
+  load_path.emplace(solver, cp.last, path_settings);
+  load_path->set_interface_step(cp.interface_step);
   std::vector<double> solved_times;
   for (std::size_t k : indices) solved_times.push_back(rp.times[k]);
   std::string stop;
@@ -337,12 +344,32 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     energy = EnergyBookkeeping::from_json(cp.samples.back().at("energy"));
     previous_interface = {cp.samples.back().at("contact_points").get<int>() > 0, cp.samples.back().at("energy").at("failed_area_m2").get<double>()};
   }
+  // Adaptive sampling: the state before each sample, to undo it when an intermediate sample is due.
+  const bool adaptive = settings.adaptive_force_change > 0.0;
+  if (adaptive && !(settings.adaptive_min_travel > 0.0 && std::isfinite(settings.adaptive_force_change)))
+    throw std::invalid_argument("reference: adaptive sampling needs a force change fraction and a minimum travel > 0");
+  double peak_force = 0.0;
+  for (const ProfileRow& r : cp.profile.rows) peak_force = std::max(peak_force, r.force.norm());
+  auto travel_between = [&](std::size_t a, std::size_t b) {
+    double d = 0.0;
+    for (const ReferenceTool& tool : rp.tools) d = std::max(d, (tool.positions[b] - tool.positions[a]).norm());
+    return d;
+  };
+  std::size_t inserted = 0;
   for (std::size_t i = cp.solved; i < indices.size(); ++i) {
     const std::size_t k = indices[i];
     reference::LoadStepReport step;
     const LoadState load = load_of(k);
+    std::vector<double> state_before;
+    LoadState load_before{};
+    double interface_step_before = 0.0;
+    if (adaptive && i > 0) {
+      state_before = load_path->last_converged_state();
+      load_before = load_path->last_converged_load();
+      interface_step_before = load_path->interface_step();
+    }
     try {
-      step = path.advance({load, k, rp.times[k]});
+      step = load_path->advance({load, k, rp.times[k]});
     } catch (const reference::LoadPathError& e) {
       stop = e.what();
       if (writer) std::fprintf(stderr, "reference %s: stopped: %s\n", scene.name.c_str(), e.what());
@@ -380,6 +407,45 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
       mode = reference::reference_mode(previous_interface, interface);
       crack_extent = solver.crack_extent(crack_direction);
     }
+    if (adaptive && i > 0) {
+      // An event or a fast change between the previous sample and this one: undo this sample and
+      // solve the one half way first (while the tool travels more than the minimum between them).
+      const std::size_t previous = indices[i - 1];
+      const std::size_t n_tools = rp.tools.size();
+      const std::size_t last = cp.profile.rows.size() - n_tools; // the previous sample's first row
+      const ProfileRow& before = cp.profile.rows[last];
+      // A fast change is a curve that leaves the straight line through the two samples before:
+      // |F_k − (F_{k−1} + (F_{k−1} − F_{k−2}) (t_k − t_{k−1}) / (t_{k−1} − t_{k−2}))| beyond the
+      // fraction of the largest force (a ramp from zero is straight: it inserts nothing).
+      double deviation = 0.0;
+      if (i > 1) {
+        const std::size_t older = last - n_tools;
+        const double t0 = cp.profile.rows[older].t, t1 = before.t, t2 = rp.times[k];
+        const double slope = t1 > t0 ? (t2 - t1) / (t1 - t0) : 0.0;
+        for (std::size_t j = 0; j < n_tools; ++j) {
+          const Eigen::Vector3d& f0 = cp.profile.rows[older + j].force;
+          const Eigen::Vector3d& f1 = cp.profile.rows[last + j].force;
+          deviation = std::max(deviation, (tool_forces[j] - (f1 + (f1 - f0) * slope)).norm());
+        }
+      }
+      const double scale = std::max({peak_force, tool_forces.front().norm(), before.force.norm()});
+      const bool event = mode != before.mode;
+      const bool fast = deviation > settings.adaptive_force_change * scale;
+      if ((event || fast) && k > previous + 1 && travel_between(previous, k) > settings.adaptive_min_travel) {
+        cp.solve_seconds += step.seconds; // the undone solve's cost is spent all the same
+        newton_total += step.newton_iterations;
+        solver.set_state(state_before);
+        load_path.emplace(solver, load_before, path_settings);
+        load_path->set_interface_step(interface_step_before);
+        indices.insert(indices.begin() + static_cast<std::ptrdiff_t>(i), previous + (k - previous) / 2);
+        solved_times.insert(solved_times.begin() + static_cast<std::ptrdiff_t>(i), rp.times[indices[i]]);
+        cp.indices = indices;
+        ++inserted;
+        --i; // the loop's ++i comes back to position i: the inserted sample
+        continue;
+      }
+    }
+    for (const Eigen::Vector3d& f : tool_forces) peak_force = std::max(peak_force, f.norm());
     previous_interface = interface;
     energy.add_sample(tool_positions, forces_on_body, solver.strain_energy(), step.equilibrium.cohesive,
                       step.equilibrium.contact_energy, solver.kinetic_energy(), solver.damping_dissipation());
@@ -416,8 +482,8 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     cp.solve_seconds += cost;
     newton_total += step.newton_iterations;
     cp.solved = i + 1;
-    cp.last = path.last_converged_load();
-    cp.interface_step = path.interface_step();
+    cp.last = load_path->last_converged_load();
+    cp.interface_step = load_path->interface_step();
     if (settings.write_fields) {
       if (pieces)
         solver.write_fields(dir / "fields" / step_name(i, true), load); // collective; atomic inside
@@ -426,7 +492,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
       if (writer) write_pvd(dir, solved_times, cp.solved, pieces);
     }
     if (cp.solved % static_cast<std::size_t>(settings.checkpoint_every) == 0) {
-      cp.state = path.last_converged_state();
+      cp.state = load_path->last_converged_state();
       if (writer) write_reference_checkpoint(cp, checkpoint_file);
     }
     const double elapsed = std::chrono::duration<double>(Clock::now() - run_begin).count();
@@ -440,7 +506,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
                    step.final_residual, tool_force.norm(), elapsed, eta);
   }
   if (!stop.empty()) {
-    cp.state = path.last_converged_state();
+    cp.state = load_path->last_converged_state();
     if (writer) write_reference_checkpoint(cp, checkpoint_file); // the last converged state, saved
   }
 
@@ -486,6 +552,12 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     tools_json.push_back(t);
   }
   solver_json["tools"] = tools_json;
+  if (adaptive)
+    solver_json["adaptive_sampling"] = {{"force_change", settings.adaptive_force_change},
+                                        {"min_travel_m", settings.adaptive_min_travel},
+                                        {"requested_samples", settings.sample_indices.size()},
+                                        {"solved_samples", indices.size()},
+                                        {"inserted_this_run", inserted}};
   if (is_tied(rp.tools.front())) { // the first tool's, as before several tools were coupled
     solver_json["tied_nodes"] = rp.tools.front().coupling.tied_nodes;
     solver_json["tied_triangles"] = rp.tools.front().coupling.tied_triangles.size();

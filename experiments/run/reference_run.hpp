@@ -35,10 +35,19 @@ struct ReferenceRunSettings {
   /// Under `mpirun -np N` (N > 1): distribute the mesh over the N processes (true) or solve the
   /// whole problem on every process (false). See reference::SolverSettings::distribute.
   bool distribute = true;
-  /// Cohesive fracture along the scene's cut_plane (Reference II; reference_fracture.hpp).
-  /// Off by default until Reference II is complete (docs/cohesive-fracture.md, "Not yet done"): the
-  /// cohesive reference of a cutting scene is opt-in (`--fracture auto|on`).
+  /// Cohesive fracture along the scene's cut_plane (Reference II; reference_fracture.hpp). `kerf
+  /// reference` and studies pass `automatic` (a cutting or tearing scene with σ_c and J_c cuts);
+  /// off here, so a program that builds its own settings asks for fracture explicitly.
   ReferenceFracture fracture = ReferenceFracture::off;
+  /// Samples that resolve the events (adaptive sampling): with `adaptive_force_change` > 0, a
+  /// solved sample whose force leaves the straight line through the two samples before it by more
+  /// than that fraction of the largest force so far (or whose interaction mode differs from the
+  /// previous sample's: first contact, rupture, cutting, re-contact) is undone, and the trajectory
+  /// sample half way between it and the previous one is solved first —
+  /// recursively, until the tool travels at most `adaptive_min_travel` [m] between the two samples.
+  /// The requested samples are all solved; the inserted ones join the profile. 0: off.
+  double adaptive_force_change = 0.0;
+  double adaptive_min_travel = 0.05e-3;
   /// Viscous regularisation of the cohesive law: relaxation time τ [s] >= 0, η = σ_c τ / δ_f
   /// (add_crack_path); 0 = none. Its dissipation is booked in the manifest's energy.
   double cohesive_viscous_time = 0.0;

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 
 namespace kerf {
@@ -153,6 +154,63 @@ TEST(ReferenceRun, ResumeFromACheckpointGivesTheUninterruptedProfile) {
 // the uninterrupted run's forces and kinetic energy bit for bit (without them the first resumed
 // step would start from rest and differ), and a quasi-static run's checkpoint is refused by a
 // dynamic run, naming the time integration; likewise a damped run's by an undamped one.
+// Adaptive sampling (ReferenceRunSettings::adaptive_force_change): on clay_pull's box, 4 requested
+// samples. Checks: every requested sample is solved; samples are inserted where the curve bends
+// (the stylus starts pulling at t = 0, so the first sample after the start lies within the minimum
+// travel of it); and a second method: the quasi-static hyperelastic problem is path-independent, so
+// a plain run on the adaptive run's final sample list gives the same forces to the solver's
+// tolerance. A resume from the adaptive run's checkpoint (which holds the inserted samples)
+// reproduces it bit for bit.
+TEST(ReferenceRun, AdaptiveSamplingInsertsSamplesWhereTheCurveBendsAndMatchesAPlainRun) {
+  const ClayPull c;
+  ReferenceRunSettings s;
+  s.sample_indices = reference_sample_indices(c.samples, 4);
+  s.write_fields = false;
+  s.checkpoint_every = 4;
+  s.adaptive_force_change = 0.02;
+  s.adaptive_min_travel = 0.05e-3;
+  const fs::path dir = scratch("adaptive");
+  const ForceProfile adaptive = run_reference(c.scene, c.mesh, s, dir);
+  const nlohmann::json m = read_json(dir / "manifest.json");
+  ASSERT_TRUE(m.at("stopped").is_null());
+  std::vector<std::size_t> solved;
+  for (const auto& rec : m.at("samples")) solved.push_back(rec.at("index").get<std::size_t>());
+  ASSERT_EQ(solved.size(), adaptive.rows.size());
+  EXPECT_GT(solved.size(), s.sample_indices.size());
+  EXPECT_TRUE(std::includes(solved.begin(), solved.end(), s.sample_indices.begin(), s.sample_indices.end()));
+  EXPECT_TRUE(std::is_sorted(solved.begin(), solved.end()));
+  // The pull starts at t = 0: the first sample after it is within the minimum travel (0.05 mm).
+  EXPECT_LE((adaptive.rows[1].position - adaptive.rows[0].position).norm(), s.adaptive_min_travel + 1e-12);
+  EXPECT_GT(adaptive.rows[1].force.norm(), 0.0);
+  // The end of the pull (t = 1.6 s, clay_pull.toml: 8 mm at 5 mm/s) is a kink: a sample lies within
+  // 0.1 s of it on each side, where the 4 requested samples are 0.87 s apart.
+  bool before_kink = false, after_kink = false;
+  for (const ProfileRow& r : adaptive.rows) {
+    before_kink = before_kink || (r.t < 1.6 && r.t > 1.5);
+    after_kink = after_kink || (r.t >= 1.6 && r.t < 1.7);
+  }
+  EXPECT_TRUE(before_kink && after_kink);
+
+  ReferenceRunSettings plain = s;
+  plain.adaptive_force_change = 0.0;
+  plain.sample_indices = solved;
+  const ForceProfile reference = run_reference(c.scene, c.mesh, plain, scratch("plain"));
+  ASSERT_EQ(reference.rows.size(), adaptive.rows.size());
+  double peak = 0.0;
+  for (const ProfileRow& r : reference.rows) peak = std::max(peak, r.force.norm());
+  for (std::size_t k = 0; k < reference.rows.size(); ++k)
+    EXPECT_LE((adaptive.rows[k].force - reference.rows[k].force).norm(), 1e-7 * peak) << "sample " << k;
+
+  // Resumed from its checkpoint (written after every 4 solved samples), the adaptive run continues
+  // with the samples it had inserted and ends with the same profile.
+  fs::remove(dir / "profile.csv");
+  fs::remove(dir / "manifest.json");
+  s.resume = true;
+  const ForceProfile resumed = run_reference(c.scene, c.mesh, s, dir);
+  ASSERT_EQ(resumed.rows.size(), adaptive.rows.size());
+  for (std::size_t k = 0; k < resumed.rows.size(); ++k) EXPECT_EQ(resumed.rows[k].force, adaptive.rows[k].force) << k;
+}
+
 TEST(ReferenceRun, DynamicResumeCarriesVelocityAndAcceleration) {
   const ClayPull c;
   ReferenceRunSettings s;
