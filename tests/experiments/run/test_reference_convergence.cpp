@@ -11,6 +11,7 @@
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"
+#include "tests/experiments/run/grasp_on_box.hpp"
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -38,7 +39,8 @@ void print(const ConvergenceStudy& s, const char* name) {
 TEST(ReferenceConvergence, ClayPullDifferencesShrink) {
   const Scene scene = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
   // clay_pull.toml: 40 × 40 × 20 mm block, x in [0, 40], y centred, base z = 0.
-  const TetMesh mesh = box_tet_mesh(Eigen::Vector3d(0, -0.02, 0), Eigen::Vector3d(0.04, 0.02, 0.02), 4, 4, 2);
+  TetMesh mesh = box_tet_mesh(Eigen::Vector3d(0, -0.02, 0), Eigen::Vector3d(0.04, 0.02, 0.02), 4, 4, 2);
+  test::add_grasp_groups_to_box(scene, mesh); // the grasp disc as the box's top triangles under it (grasp_on_box.hpp)
   ReferenceRunSettings s;
   s.sample_indices = reference_sample_indices(sample(scene.tools.front().trajectory).samples.size(), 3);
   s.write_fields = false;
