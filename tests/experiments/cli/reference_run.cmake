@@ -1,7 +1,8 @@
-# kerf reference as a user runs it: clay_pull at 6 evenly spaced samples writes the profile, the
-# manifest and the ParaView collection with one .vtu per sample.
+# kerf reference as a user runs it: clay_pull at 6 evenly spaced samples (adaptive sampling off, so
+# that the count is known; ReferenceRun.AdaptiveSampling* tests it) writes the profile, the manifest
+# and the ParaView collection with one .vtu per sample.
 file(REMOVE_RECURSE ${WORK})
-execute_process(COMMAND ${KERF} reference clay_pull --samples 6 -o ${WORK}
+execute_process(COMMAND ${KERF} reference clay_pull --samples 6 --adaptive 0 -o ${WORK}
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "kerf reference clay_pull failed (${rc}):\n${out}\n${err}")
