@@ -35,6 +35,13 @@ std::string latex_escape(const std::string& s) {
   return out;
 }
 
+/// A Markdown cell: a "|" in the text would end the cell ("RMS |F|").
+std::string markdown_cell(const std::string& s) {
+  std::string out;
+  for (char ch : s) out += ch == '|' ? std::string("\\|") : std::string(1, ch);
+  return out;
+}
+
 std::string csv_field(const std::string& s) {
   if (s.find_first_of(",\"\n") == std::string::npos) return s;
   std::string out = "\"";
@@ -65,48 +72,60 @@ std::string StudyTable::shown(std::size_t column, const Cell& cell) const {
   return buffer;
 }
 
+bool StudyTable::numeric(std::size_t column) const {
+  for (const auto& row : m_rows)
+    if (std::holds_alternative<std::optional<double>>(row[column])) return true;
+  return false;
+}
+
 std::string StudyTable::markdown() const {
   std::string out = "|";
   for (const Column& c : m_columns) {
     out += ' ';
-    out += header(c);
+    out += markdown_cell(header(c));
     out += " |";
   }
   out += "\n|";
-  for (std::size_t c = 0; c < m_columns.size(); ++c) out += std::holds_alternative<std::string>(m_rows.empty() ? Cell{std::string{}} : m_rows.front()[c]) ? "---|" : "---:|";
+  for (std::size_t c = 0; c < m_columns.size(); ++c) out += numeric(c) ? "---:|" : "---|";
   out += "\n";
   for (const auto& row : m_rows) {
     out += "|";
     for (std::size_t c = 0; c < row.size(); ++c) {
       out += ' ';
-      out += shown(c, row[c]);
+      out += markdown_cell(shown(c, row[c]));
       out += " |";
     }
     out += "\n";
   }
+  if (!m_footnote.empty()) out += "\n" + m_footnote + "\n";
   return out;
 }
 
 
 std::string StudyTable::latex() const {
   std::string spec;
-  for (std::size_t c = 0; c < m_columns.size(); ++c)
-    spec += (!m_rows.empty() && std::holds_alternative<std::string>(m_rows.front()[c])) ? "l" : "r";
+  for (std::size_t c = 0; c < m_columns.size(); ++c) spec += numeric(c) ? "r" : "l";
   std::string out = "\\begin{tabular}{" + spec + "}\n\\toprule\n";
   for (std::size_t c = 0; c < m_columns.size(); ++c) {
     if (c) out += " & ";
     out += latex_escape(header(m_columns[c]));
   }
   out += " \\\\\n\\midrule\n";
-  for (const auto& row : m_rows) {
+  for (std::size_t r = 0; r < m_rows.size(); ++r) {
+    const auto& row = m_rows[r];
+    const bool continues_group = m_grouped && r > 0 && shown(0, row[0]) == shown(0, m_rows[r - 1][0]);
+    if (m_grouped && r > 0 && !continues_group) out += "\\midrule\n";
     for (std::size_t c = 0; c < row.size(); ++c) {
-      const std::string cell = shown(c, row[c]);
+      const std::string cell = c == 0 && continues_group ? std::string() : shown(c, row[c]);
       if (c) out += " & ";
       out += cell == "–" ? std::string("--") : latex_escape(cell);
     }
     out += " \\\\\n";
   }
-  return out + "\\bottomrule\n\\end{tabular}\n";
+  out += "\\bottomrule\n";
+  if (!m_footnote.empty())
+    out += "\\multicolumn{" + std::to_string(m_columns.size()) + "}{l}{\\footnotesize " + latex_escape(m_footnote) + "} \\\\\n";
+  return out + "\\end{tabular}\n";
 }
 
 std::string StudyTable::csv() const {
