@@ -1,5 +1,5 @@
 #pragma once
-// The machine a study's costs were measured on, for the table's footnote: the CPU model and the
+// The machine a study's costs were measured on, for the table's caption: the CPU model and the
 // number of cores (issue 23: "costs ... labelled with the machine (CPU model, cores)").
 
 #include <string>

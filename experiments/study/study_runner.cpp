@@ -605,7 +605,7 @@ StudyTable StudyResult::table() const {
                 {"note", "", 3, 1.0}});
   t.group_by_first_column(true);
   if (!machine.empty())
-    t.set_footnote("Costs: wall time per servo step on " + machine + ", " + std::to_string(jobs) + " job(s)" +
+    t.set_caption("Costs: wall time per servo step on " + machine + ", " + std::to_string(jobs) + " job(s)" +
                    (ranks > 1 ? " × " + std::to_string(ranks) + " ranks" : std::string()) +
                    (jobs * ranks > 1 ? " at once (a run beside others is slower; --jobs 1 for undisturbed costs)" : "") + ".");
   using O = std::optional<double>;

@@ -67,7 +67,7 @@ struct StudyResult {
   std::vector<SceneReference> references; ///< one per scene with a reference, in study order
   std::string machine;        ///< the machine the costs were measured on (machine_label.hpp)
   int jobs = 1, ranks = 1;    ///< how the runs were spread (StudyExecution)
-  /// The publishable table, rows grouped by scene, with a footnote naming the machine and the
+  /// The publishable table, rows grouped by scene, with a caption naming the machine and the
   /// jobs the costs were measured with.
   StudyTable table() const;
   int reference_runs = 0;     ///< reference solves actually run (0 on a fully cached re-run)

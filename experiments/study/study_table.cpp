@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 
 namespace kerf {
 
@@ -21,14 +23,44 @@ std::string header(const StudyTable::Column& c) {
   return h;
 }
 
+/// LaTeX for the non-ASCII characters kerf's tables use (units, notes), so that the table
+/// compiles with pdflatex's default set-up (OT1, no inputenc declarations needed).
+constexpr std::pair<const char*, const char*> latex_unicode[] = {
+    {"µ", "\\textmu{}"},         {"×", "\\texttimes{}"},          {"≤", "\\ensuremath{\\le}"},
+    {"≥", "\\ensuremath{\\ge}"}, {"→", "\\ensuremath{\\to}"},    {"–", "--"},
+    {"—", "---"},                 {"φ", "\\ensuremath{\\varphi}"}, {"ε", "\\ensuremath{\\varepsilon}"},
+    {"δ", "\\ensuremath{\\delta}"}, {"σ", "\\ensuremath{\\sigma}"}, {"ν", "\\ensuremath{\\nu}"},
+    {"η", "\\ensuremath{\\eta}"},   {"μ", "\\ensuremath{\\mu}"},    {"Δ", "\\ensuremath{\\Delta}"},
+    {"±", "\\ensuremath{\\pm}"},    {"²", "\\textsuperscript{2}"}, {"°", "\\textdegree{}"},
+    {"…", "\\ldots{}"},           {"∞", "\\ensuremath{\\infty}"},
+};
+
 std::string latex_escape(const std::string& s) {
   std::string out;
-  for (char ch : s) {
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const char ch = s[k];
+    if (static_cast<unsigned char>(ch) >= 0x80) {
+      bool mapped = false;
+      for (const auto& [utf8, latex] : latex_unicode) {
+        const std::string_view u(utf8);
+        if (s.compare(k, u.size(), u) == 0) {
+          out += latex;
+          k += u.size() - 1;
+          mapped = true;
+          break;
+        }
+      }
+      if (!mapped) out += ch;
+      continue;
+    }
     switch (ch) {
     case '&': case '%': case '$': case '#': case '_': case '{': case '}': out += '\\'; out += ch; break;
     case '~': out += "\\textasciitilde{}"; break;
     case '^': out += "\\textasciicircum{}"; break;
     case '\\': out += "\\textbackslash{}"; break;
+    case '|': out += "\\textbar{}"; break; // OT1 sets "|" as an em dash
+    case '<': out += "\\textless{}"; break;
+    case '>': out += "\\textgreater{}"; break;
     default: out += ch;
     }
   }
@@ -79,7 +111,7 @@ bool StudyTable::numeric(std::size_t column) const {
 }
 
 std::string StudyTable::markdown() const {
-  std::string out = "|";
+  std::string out = m_caption.empty() ? "|" : m_caption + "\n\n|";
   for (const Column& c : m_columns) {
     out += ' ';
     out += markdown_cell(header(c));
@@ -97,7 +129,6 @@ std::string StudyTable::markdown() const {
     }
     out += "\n";
   }
-  if (!m_footnote.empty()) out += "\n" + m_footnote + "\n";
   return out;
 }
 
@@ -123,8 +154,8 @@ std::string StudyTable::latex() const {
     out += " \\\\\n";
   }
   out += "\\bottomrule\n";
-  if (!m_footnote.empty())
-    out += "\\multicolumn{" + std::to_string(m_columns.size()) + "}{l}{\\footnotesize " + latex_escape(m_footnote) + "} \\\\\n";
+  if (!m_caption.empty())
+    out += "\\multicolumn{" + std::to_string(m_columns.size()) + "}{l}{\\footnotesize " + latex_escape(m_caption) + "} \\\\\n";
   return out + "\\end{tabular}\n";
 }
 

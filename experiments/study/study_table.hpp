@@ -27,11 +27,12 @@ public:
   /// Appends a row; its size must equal the column count (std::invalid_argument otherwise).
   void add_row(std::vector<Cell> row);
 
-  /// A line below the table (e.g. the machine the costs were measured on): Markdown prints it
-  /// after the table, LaTeX as a last full-width row under \bottomrule; CSV has no place for it
-  /// (RFC 4180 has no comments) and leaves it out.
-  void set_footnote(std::string text) { m_footnote = std::move(text); }
-  [[nodiscard]] const std::string& footnote() const { return m_footnote; }
+  /// A line that goes with the table (e.g. the machine the costs were measured on): Markdown
+  /// prints it above the table (so that the file still ends with the table's last row), LaTeX as
+  /// a last full-width row under \bottomrule; CSV has no place for it (RFC 4180 has no comments)
+  /// and leaves it out.
+  void set_caption(std::string text) { m_caption = std::move(text); }
+  [[nodiscard]] const std::string& caption() const { return m_caption; }
   /// Rows are grouped by their first column (the study's scenes) in the LaTeX form.
   void group_by_first_column(bool grouped) { m_grouped = grouped; }
 
@@ -55,7 +56,7 @@ private:
   [[nodiscard]] std::string shown(std::size_t column, const Cell& cell) const;
   /// A column holding at least one number (right-aligned), else text.
   [[nodiscard]] bool numeric(std::size_t column) const;
-  std::string m_footnote;
+  std::string m_caption;
   bool m_grouped = false;
   std::vector<Column> m_columns;
   std::vector<std::vector<Cell>> m_rows;

@@ -209,3 +209,42 @@ TEST(StudyReport, PlotsDrawTheReferenceWithItsBandAndEveryModel) {
   EXPECT_TRUE(pareto_series.count("reference uncertainty"));
   EXPECT_TRUE(pareto_series.count("budget 1 kHz") && pareto_series.count("budget 10 kHz"));
 }
+
+TEST(StudyReport, TheLatexTablesAreAsciiWithOneCellPerColumn) {
+  // No pdflatex on the build machine: the syntax is checked instead. Every row of study.tex and
+  // verification.tex has as many cells as the tabular has columns (unescaped "&" = columns - 1),
+  // braces balance, and the text is ASCII (µ, ×, φ, ≤ … written as LaTeX commands), so that
+  // pdflatex's default set-up typesets it with booktabs.
+  const ThreeLevelStudy& s = three_level_study();
+  write_study_report(s.spec, s.result, s.out);
+  for (const char* name : {"study.tex", "verification.tex"}) {
+    std::ifstream in(s.out / name);
+    std::stringstream text;
+    text << in.rdbuf();
+    const std::string tex = text.str();
+    for (unsigned char c : tex) ASSERT_LT(c, 0x80) << name << " holds a non-ASCII byte:\n" << tex;
+    const std::size_t spec_begin = tex.find("\\begin{tabular}{") + 16;
+    const std::size_t columns = tex.find('}', spec_begin) - spec_begin;
+    int depth = 0;
+    std::istringstream lines(tex);
+    std::string line;
+    int rows = 0;
+    while (std::getline(lines, line)) {
+      for (std::size_t k = 0; k < line.size(); ++k) {
+        if (line[k] == '\\') {
+          ++k; // an escaped character or a command's first letter
+          continue;
+        }
+        depth += line[k] == '{' ? 1 : line[k] == '}' ? -1 : 0;
+        EXPECT_GE(depth, 0) << name << ": " << line;
+      }
+      if (line.size() < 2 || line.compare(line.size() - 2, 2, "\\\\") != 0 || line.find("\\multicolumn") == 0) continue;
+      std::size_t cells = 1;
+      for (std::size_t k = 0; k < line.size(); ++k) cells += line[k] == '&' && (k == 0 || line[k - 1] != '\\');
+      EXPECT_EQ(cells, columns) << name << ": " << line;
+      ++rows;
+    }
+    EXPECT_EQ(depth, 0) << name;
+    EXPECT_GE(rows, 3) << name; // the header and at least two rows
+  }
+}

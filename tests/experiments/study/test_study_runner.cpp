@@ -680,3 +680,12 @@ TEST(StudyRunner, AModelRunsAtEachOfItsResolutions) {
   }
   fs::remove_all(out);
 }
+
+TEST(StudySpec, TheFullStudyVerifiesItsReferenceAndSweepsTheSprings) {
+  // experiments/studies/full.toml: three mesh levels (the GCI needs three) and a resolution curve.
+  const StudySpec s = read_study(fs::path(KERF_STUDIES_DIR) / "full.toml");
+  ASSERT_TRUE(s.has_reference);
+  EXPECT_GE(s.reference.refinements.size(), 3u);
+  ASSERT_TRUE(s.resolutions.count("springs"));
+  EXPECT_GE(s.resolutions.at("springs").size(), 2u);
+}

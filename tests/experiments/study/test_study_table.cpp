@@ -29,7 +29,7 @@ TEST(StudyTable, Markdown) {
 
 TEST(StudyTable, LatexBooktabsEscapesText) {
   EXPECT_EQ(example().latex(), "\\begin{tabular}{lrr}\n\\toprule\n"
-                               "model & RMS error [\\%] & p99 cost [µs] \\\\\n\\midrule\n"
+                               "model & RMS error [\\%] & p99 cost [\\textmu{}s] \\\\\n\\midrule\n"
                                "fracture & 1.23 & 4.2 \\\\\n"
                                "springs\\_a\\&b & -- & 1.5e+02 \\\\\n"
                                "\\bottomrule\n\\end{tabular}\n");
@@ -63,22 +63,23 @@ TEST(StudyTable, RowsMustMatchColumnsAndFilesAreWritten) {
   EXPECT_EQ(text.str(), t.markdown());
 }
 
-TEST(StudyTable, GroupsByTheFirstColumnTextInANumericColumnAndAFootnote) {
+TEST(StudyTable, GroupsByTheFirstColumnTextInANumericColumnAndACaption) {
   // Rows of two scenes: LaTeX rules off each scene's group and names the scene once; a numeric
-  // column may hold text ("below reference uncertainty") and stays right-aligned; the footnote
-  // (the machine of the cost columns) follows the table in Markdown and LaTeX, not in CSV.
+  // column may hold text ("below reference uncertainty") and stays right-aligned; the
+  // caption (the machine of the cost columns) precedes the table in Markdown (the file still ends
+  // with the last row), follows it in LaTeX, and is not in CSV.
   StudyTable t({{"scene", "", 3, 1.0}, {"model", "", 3, 1.0}, {"RMS error", "%", 3, 100.0}});
   t.add_row({std::string("a"), std::string("reference L1"), std::optional<double>()});
   t.add_row({std::string("a"), std::string("springs"), std::string("below reference uncertainty")});
   t.add_row({std::string("b"), std::string("edge"), std::optional<double>(0.5)});
-  t.set_footnote("Costs on: Test CPU, 2 cores");
+  t.set_caption("Costs on: Test CPU, 2 cores");
   t.group_by_first_column(true);
-  EXPECT_EQ(t.markdown(), "| scene | model | RMS error [%] |\n"
+  EXPECT_EQ(t.markdown(), "Costs on: Test CPU, 2 cores\n\n"
+                          "| scene | model | RMS error [%] |\n"
                           "|---|---|---:|\n"
                           "| a | reference L1 | – |\n"
                           "| a | springs | below reference uncertainty |\n"
-                          "| b | edge | 50 |\n"
-                          "\nCosts on: Test CPU, 2 cores\n");
+                          "| b | edge | 50 |\n");
   EXPECT_EQ(t.latex(), "\\begin{tabular}{llr}\n\\toprule\n"
                        "scene & model & RMS error [\\%] \\\\\n\\midrule\n"
                        "a & reference L1 & -- \\\\\n"
