@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Plots of a kerf study (issue 7), from kerf's own CSV files, with matplotlib.
 
-  plot_study.py profiles OUT_STEM [LABEL=PROFILE.csv ...] [--axis x|y|z|-x|-y|-z]
-                 [--reference LABEL=REFERENCE.csv [--band-source TEXT]] [--time-panel] [--title TEXT]
+  plot_study.py profiles OUT_STEM [LABEL=PROFILE.csv ...] [--run LABEL PROFILE.csv ...] [--axis x|y|z|-x|-y|-z]
+                 [--reference LABEL REFERENCE.csv [--band-source TEXT]] [--time-panel] [--title TEXT]
       the resisting force along the axis of advance against tool travel: the reference (a profile
       CSV with band_low, band_high columns [N]) in black with its uncertainty band in grey, one
       curve per fast model on top, the reference's interaction modes shaded where they occur
@@ -285,7 +285,10 @@ def main(argv):
     p.add_argument("stem")
     p.add_argument("runs", nargs="*", help="LABEL=PROFILE.csv")
     p.add_argument("--axis", default="-z", choices=list(AXES))
-    p.add_argument("--reference", help="LABEL=REFERENCE.csv: the finest reference with band_low, band_high [N]")
+    p.add_argument("--run", nargs=2, action="append", default=[], metavar=("LABEL", "PROFILE"),
+                   help="a fast model's profile (a label may hold '=')")
+    p.add_argument("--reference", nargs=2, metavar=("LABEL", "REFERENCE"),
+                   help="the finest reference: a profile CSV with band_low, band_high [N]")
     p.add_argument("--band-source", default="", help="what the band is, for the legend")
     p.add_argument("--time-panel", action="store_true", help="force against time beside force against travel")
     p.add_argument("--title", default="")
@@ -316,11 +319,8 @@ def main(argv):
                 sys.exit(f"expected LABEL=PROFILE.csv, got {item!r}")
             label, path = item.split("=", 1)
             runs.append((label, path))
-        reference = None
-        if args.reference:
-            if "=" not in args.reference:
-                sys.exit(f"expected LABEL=REFERENCE.csv, got {args.reference!r}")
-            reference = tuple(args.reference.split("=", 1))
+        runs += [tuple(r) for r in args.run]
+        reference = tuple(args.reference) if args.reference else None
         plot_profiles(args.stem, runs, args.axis, reference, args.band_source, args.time_panel, args.title)
     else:
         plot_pareto(args.stem, args.table, args.error, args.cost, args.label, args.scene, args.floor, args.title)

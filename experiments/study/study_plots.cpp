@@ -36,12 +36,10 @@ void run_plot_script(const std::vector<std::string>& args) {
 void plot_profiles(const std::filesystem::path& stem, const std::vector<std::pair<std::string, std::filesystem::path>>& runs,
                    const std::string& axis, const std::optional<ProfilePlotReference>& reference, bool time_panel,
                    const std::string& title) {
-  std::vector<std::string> args{"profiles", stem.string()};
-  for (const auto& [label, csv] : runs) args.push_back(label + "=" + csv.string());
-  args.push_back("--axis=" + axis);
-  args.push_back("--title=" + title);
+  std::vector<std::string> args{"profiles", stem.string(), "--axis=" + axis, "--title=" + title};
+  for (const auto& [label, csv] : runs) args.insert(args.end(), {"--run", label, csv.string()}); // a label may hold "="
   if (reference) {
-    args.push_back("--reference=" + reference->label + "=" + reference->csv.string());
+    args.insert(args.end(), {"--reference", reference->label, reference->csv.string()});
     args.push_back("--band-source=" + reference->band_source);
   }
   if (time_panel) args.push_back("--time-panel");

@@ -483,11 +483,16 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     std::map<int, ForceProfile> references;
     SceneReference verified{scene.name, scene.tools.front().name, {}, {}, {}, std::nullopt, ""};
     std::vector<ReferenceLevel> levels;
+    std::string failed_levels; // coarser levels that failed: the table goes on without them, saying so
     for (std::size_t k : scenes[s].levels) {
       const ReferenceSolve& solve = solves[k];
-      if (!fs::exists(solve.dir / "profile.csv"))
-        throw std::runtime_error("reference of scene " + scene.name + " at level " + std::to_string(solve.level) + " failed: " +
-                                 (fs::exists(solve.dir / "error.txt") ? read_text(solve.dir / "error.txt") : "no profile written"));
+      if (!fs::exists(solve.dir / "profile.csv")) {
+        const std::string why = "reference of scene " + scene.name + " at level " + std::to_string(solve.level) + " failed: " +
+                                (fs::exists(solve.dir / "error.txt") ? read_text(solve.dir / "error.txt") : "no profile written");
+        if (k == scenes[s].levels.back()) throw std::runtime_error(why); // the finest: nothing to score against
+        failed_levels += "L" + std::to_string(solve.level) + " failed (" + why.substr(why.find("failed: ") + 8) + "); ";
+        continue;
+      }
       references[solve.level] = read_profile_csv(solve.dir / "profile.csv");
       verified.levels.push_back(solve.level);
       verified.element_sizes.push_back(study_reference_element_size(scene, solve.level));
@@ -509,6 +514,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       } catch (const std::exception& e) {
         verified.note = std::string("no GCI available: ") + e.what();
       }
+      verified.note = failed_levels + verified.note;
       char size[64];
       std::snprintf(size, sizeof size, "mesh h = %.3g mm; ", study_reference_element_size(scene, finest_level) * 1e3);
       StudyRow row{scene.name, "reference L" + std::to_string(finest_level), std::nullopt, cost_statistics(*finest), size + verified.note, {}};

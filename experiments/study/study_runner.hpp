@@ -101,7 +101,9 @@ struct StudyExecution {
 /// per solve named by reference_cache_key (reference_cache.hpp) with its `key.txt`. A fitted
 /// calibration's row "MODEL (calibrated)" comes right after MODEL's row, its note saying what was
 /// fitted on which trajectory; its parameter file is `out/SCENE/MODEL-calibrated/parameters.toml`. Rank 0 returns the rows; other
-/// ranks return no rows (and the total reference runs). Throws if a reference solve failed.
+/// ranks return no rows (and the total reference runs). Throws if a scene's finest reference solve
+/// failed; a coarser level that failed is left out, the reference row's note saying why (the
+/// solution verification then has the levels that remain).
 StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
                       const StudyExecution& execution = {});
 

@@ -248,3 +248,31 @@ TEST(StudyReport, TheLatexTablesAreAsciiWithOneCellPerColumn) {
     EXPECT_GE(rows, 3) << name; // the header and at least two rows
   }
 }
+
+TEST(StudyReport, ACoarseLevelThatFailsIsLeftOutSayingWhy) {
+  // A coarse mesh may not resolve the scene (clay_pull's grasp at 4h holds no node): the study goes
+  // on with the levels that solved — two here, so no GCI — and the reference row names the failure.
+  const fs::path dir = fs::temp_directory_path() / ("kerf_test_study_report3_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const StudySpec spec = read_study(write_file(dir / "fail.toml", "[study]\nname = \"fail\"\nscenes = [\"potato_rect_cut\"]\n"
+                                                                  "models = [\"fracture\"]\n[reference]\nrefinements = [-2, -1, 0]\nsamples = 6\n"));
+  const ReferenceRunner inner = power_law_reference();
+  const ReferenceRunner failing = [&](const Scene& scene, const StudyReferenceSpec& settings, int level,
+                                      const std::vector<std::size_t>& indices, const fs::path& d) {
+    if (scene.geometry.element_size > 7e-3) throw std::runtime_error("no node within the grasp");
+    return inner(scene, settings, level, indices, d);
+  };
+  const StudyResult r = run_study(spec, dir / "out", failing);
+  ASSERT_EQ(r.rows.size(), 3u); // reference L0, reference L-1, fracture
+  EXPECT_NE(r.rows[0].note.find("L-2 failed (no node within the grasp)"), std::string::npos) << r.rows[0].note;
+  EXPECT_NE(r.rows[0].note.find("no GCI available: 2 mesh level(s)"), std::string::npos) << r.rows[0].note;
+  ASSERT_TRUE(r.rows[2].metrics.has_value());
+  // The finest level failing leaves nothing to score against: an error.
+  const ReferenceRunner finest_fails = [&](const Scene& scene, const StudyReferenceSpec& settings, int level,
+                                           const std::vector<std::size_t>& indices, const fs::path& d) -> ForceProfile {
+    if (scene.geometry.element_size < 3e-3) throw std::runtime_error("diverged");
+    return inner(scene, settings, level, indices, d);
+  };
+  EXPECT_THROW(run_study(spec, dir / "out2", finest_fails), std::runtime_error);
+  fs::remove_all(dir);
+}

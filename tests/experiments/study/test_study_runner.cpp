@@ -3,6 +3,7 @@
 
 #include "experiments/study/study_runner.hpp"
 #include "experiments/study/model_resolution.hpp"
+#include "experiments/study/study_report.hpp"
 
 #include "experiments/run/model_catalogue.hpp"
 #include "experiments/run/scene_mesh.hpp"
@@ -678,6 +679,12 @@ TEST(StudyRunner, AModelRunsAtEachOfItsResolutions) {
     text << manifest.rdbuf();
     EXPECT_NE(text.str().find("\"cells_per_side\": " + std::to_string(n)), std::string::npos) << text.str().substr(0, 400);
   }
+  // Both are drawn, by their labels (which hold "="), in the scene's profile plot.
+  write_study_report(spec, r, out);
+  std::ifstream plotted(out / "clay_pull_profiles.csv");
+  std::stringstream data;
+  data << plotted.rdbuf();
+  for (const char* label : {",springs [N = 2],", ",springs [N = 3],"}) EXPECT_NE(data.str().find(label), std::string::npos) << label;
   fs::remove_all(out);
 }
 
