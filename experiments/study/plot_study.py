@@ -163,7 +163,7 @@ def plot_profiles(stem, runs, axis, reference=None, band_source="", time_panel=F
 
 def plot_pareto(stem, table, error_column, cost_column, label_column, scene=None, floor=None, title=""):
     """Error against p99 cost, one line per model through its resolutions (rows "MODEL" or
-    "MODEL [resolution]", in cost order), every point labelled; a row whose error is below the
+    "MODEL [resolution]", in the table's order), every point labelled; a row whose error is below the
     reference uncertainty is drawn on the floor (a downward triangle)."""
     with open(table, newline="", encoding="utf-8") as f:
         rows = list(csv.DictReader(f))
@@ -198,7 +198,7 @@ def plot_pareto(stem, table, error_column, cost_column, label_column, scene=None
     data = []
     every = [p for points in series.values() for p in points]
     for base, points in series.items():
-        points.sort()
+        # In the table's order: a model's resolutions as the study lists them (ascending).
         line, = ax.plot([c for c, _, _, _ in points], [e for _, e, _, _ in points], marker="o", ms=4, lw=1.2, label=base)
         for c, e, label, below in points:
             if below:
