@@ -9,6 +9,8 @@
 #include "experiments/run/model_catalogue.hpp"
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/study/study_runner.hpp"
+#include "experiments/study/study_plots.hpp"
+#include "experiments/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>
 
@@ -275,4 +277,18 @@ TEST(StudyReport, ACoarseLevelThatFailsIsLeftOutSayingWhy) {
   };
   EXPECT_THROW(run_study(spec, dir / "out2", finest_fails), std::runtime_error);
   fs::remove_all(dir);
+}
+
+TEST(StudyReport, TheForceTimePanelIsForToolsThatHoldOrRetreat) {
+  // potato_rect_cut: the blade advances along -z (its cutting direction), cuts, holds 0.5 s and
+  // retreats; clay_pull: the stylus pulls up (+z) and holds. Without the hold and the retreat the
+  // potato's travel never folds back: no time panel.
+  Scene potato = read_scene(fs::path(KERF_SCENES_DIR) / "potato_rect_cut.toml");
+  const Scene clay = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
+  EXPECT_EQ(axis_name(advance_direction(potato)), "-z");
+  EXPECT_EQ(axis_name(advance_direction(clay)), "z");
+  EXPECT_TRUE(holds_or_retreats(potato));
+  EXPECT_TRUE(holds_or_retreats(clay));
+  potato.tools.front().trajectory.segments.resize(2); // approach, cut
+  EXPECT_FALSE(holds_or_retreats(potato));
 }
