@@ -60,6 +60,10 @@ std::string percent(double fraction) {
   return b;
 }
 
+std::string error_of(const MeasuredRow& r) {
+  return r.below_reference_uncertainty ? std::string("below the reference's uncertainty") : percent(*r.rms_error);
+}
+
 std::string microseconds(double seconds) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g µs", 1e6 * seconds);
@@ -93,7 +97,12 @@ std::vector<MeasuredRow> read_study_rows(const std::filesystem::path& csv) {
     r.line = number_of_line;
     r.scene = f[scene];
     r.model = f[model];
-    if (const auto e = number(f[error], csv, number_of_line)) r.rms_error = *e / 100.0; // column in %
+    if (f[error] == "below reference uncertainty") {
+      r.rms_error = 0.0;
+      r.below_reference_uncertainty = true;
+    } else if (const auto e = number(f[error], csv, number_of_line)) {
+      r.rms_error = *e / 100.0; // column in %
+    }
     if (const auto c = number(f[cost], csv, number_of_line)) r.p99_cost = *c * 1e-6;    // column in µs
     r.text = line;
     rows.push_back(std::move(r));
@@ -133,7 +142,7 @@ Recommendation recommend_model(const std::vector<MeasuredRow>& rows, const std::
   }
   if (best) {
     out.choice = *best;
-    out.reason = best->model + ": RMS force error " + percent(*best->rms_error) + " <= " + percent(max_error) +
+    out.reason = best->model + ": RMS force error " + error_of(*best) + (best->below_reference_uncertainty ? "" : " <= " + percent(max_error)) +
                  ", p99 cost " + microseconds(*best->p99_cost) + " <= " + microseconds(budget) +
                  " (the cheapest of the rows that meet both)";
     return out;
@@ -142,9 +151,9 @@ Recommendation recommend_model(const std::vector<MeasuredRow>& rows, const std::
   const auto accurate = *std::min_element(scored.begin(), scored.end(), [](auto a, auto b) { return *a->rms_error < *b->rms_error; });
   const auto cheap = *std::min_element(scored.begin(), scored.end(), [](auto a, auto b) { return *a->p99_cost < *b->p99_cost; });
   out.reason = "none of the " + std::to_string(scored.size()) + " measured fast-model rows of " + scene +
-               " meets both: the most accurate, " + accurate->model + ", errs " + percent(*accurate->rms_error) +
+               " meets both: the most accurate, " + accurate->model + ", errs " + error_of(*accurate) +
                " at p99 " + microseconds(*accurate->p99_cost) + "; the cheapest, " + cheap->model + ", costs " +
-               microseconds(*cheap->p99_cost) + " at " + percent(*cheap->rms_error) + " (budget " + percent(max_error) +
+               microseconds(*cheap->p99_cost) + " at " + error_of(*cheap) + " (budget " + percent(max_error) +
                ", " + microseconds(budget) + ")";
   return out;
 }

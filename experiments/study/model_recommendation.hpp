@@ -15,14 +15,18 @@ struct MeasuredRow {
   std::filesystem::path table;        ///< the CSV it came from
   std::size_t line = 0;               ///< its line in that file (header = 1)
   std::string scene, model;           ///< model with its variant ("springs (calibrated)")
-  std::optional<double> rms_error;    ///< normalised RMS force error [–]
+  std::optional<double> rms_error;    ///< normalised RMS force error [–]; 0 when below the reference's uncertainty
+  /// The table says "below reference uncertainty": the error is smaller than the reference can
+  /// resolve; such a row meets every error budget the table can answer for.
+  bool below_reference_uncertainty = false;
   std::optional<double> p99_cost;     ///< p99 cost per servo step [s]
   std::string text;                   ///< the row as written, the evidence
 };
 
 /// Reads the scored rows of a study.csv (columns "scene", "model", "RMS force error [%]",
-/// "p99 cost [µs]"; RFC 4180 quoting). Throws std::runtime_error naming file:line on a malformed
-/// file, missing columns, or an error or cost that is neither empty nor a finite number >= 0.
+/// "p99 cost [µs]"; RFC 4180 quoting). An error cell "below reference uncertainty" reads as 0 with
+/// below_reference_uncertainty set. Throws std::runtime_error naming file:line on a malformed
+/// file, missing columns, or an error or cost that is neither empty, that text, nor a finite number >= 0.
 std::vector<MeasuredRow> read_study_rows(const std::filesystem::path& csv);
 
 /// Every study.csv under `directory` (recursively), or `directory` itself if it is a file; sorted.

@@ -49,6 +49,7 @@ ProfileMetrics compare_profiles(const ForceProfile& model, const ForceProfile& r
   out.normalised_rms_force_error = std::sqrt(sum_squared / n) / peak_reference;
   out.peak_force_error = (peak_model - peak_reference) / peak_reference;
   out.mode_agreement = static_cast<double>(same_mode) / n;
+  out.reference_peak_force = peak_reference;
 
   const auto rm = rupture_travel(m), rr = rupture_travel(r);
   if (rm && rr) out.rupture_displacement_error = *rm - *rr;

@@ -29,6 +29,9 @@ struct ProfileMetrics {
   double work_error = 0.0;
   /// Fraction of samples where both profiles report the same interaction mode.
   double mode_agreement = 0.0;
+  /// max_k |f_r,k| over the compared samples [N]: the scale of the relative measures, so that an
+  /// error can be set beside the reference's own uncertainty in newtons.
+  double reference_peak_force = 0.0;
 };
 
 /// The steady cutting force a blade should feel (paper 001 Eq. 10) and the direction it advances.

@@ -1,5 +1,6 @@
 #include "experiments/study/study_plots.hpp"
 
+#include <cstdio>
 #include <stdexcept>
 
 #include <spawn.h>
@@ -32,17 +33,61 @@ void run_plot_script(const std::vector<std::string>& args) {
 
 } // namespace
 
-void plot_profiles(const std::filesystem::path& stem,
-                   const std::vector<std::pair<std::string, std::filesystem::path>>& runs, const std::string& axis) {
-  std::vector<std::string> args{"profiles", stem.string(), "--axis=" + axis};
-  for (const auto& [label, csv] : runs) args.push_back(label + "=" + csv.string());
+void plot_profiles(const std::filesystem::path& stem, const std::vector<std::pair<std::string, std::filesystem::path>>& runs,
+                   const std::string& axis, const std::optional<ProfilePlotReference>& reference, bool time_panel,
+                   const std::string& title) {
+  std::vector<std::string> args{"profiles", stem.string(), "--axis=" + axis, "--title=" + title};
+  for (const auto& [label, csv] : runs) args.insert(args.end(), {"--run", label, csv.string()}); // a label may hold "="
+  if (reference) {
+    args.insert(args.end(), {"--reference", reference->label, reference->csv.string()});
+    args.push_back("--band-source=" + reference->band_source);
+  }
+  if (time_panel) args.push_back("--time-panel");
   run_plot_script(args);
 }
 
 void plot_pareto(const std::filesystem::path& stem, const std::filesystem::path& table_csv, const std::string& error_column,
-                 const std::string& cost_column, const std::string& label_column) {
-  run_plot_script({"pareto", stem.string(), table_csv.string(), "--error", error_column, "--cost", cost_column,
-                   "--label", label_column});
+                 const std::string& cost_column, const std::string& label_column, const std::string& scene,
+                 std::optional<double> floor, const std::string& title) {
+  std::vector<std::string> args{"pareto", stem.string(), table_csv.string(), "--error", error_column, "--cost", cost_column,
+                                "--label", label_column, "--title=" + title};
+  if (!scene.empty()) args.push_back("--scene=" + scene);
+  if (floor) {
+    char text[64];
+    std::snprintf(text, sizeof text, "--floor=%.17g", *floor);
+    args.push_back(text);
+  }
+  run_plot_script(args);
+}
+
+Eigen::Vector3d advance_direction(const Scene& scene) {
+  const Tool& tool = scene.tools.front();
+  if (tool.kind == Tool::Kind::blade) return tool.blade.cutting_direction.normalized();
+  Eigen::Vector3d from = tool.trajectory.start;
+  for (const TrajectorySegment& s : tool.trajectory.segments)
+    if (s.kind == TrajectorySegment::Kind::move) {
+      if ((s.target - from).norm() > 0.0) return (s.target - from).normalized();
+      from = s.target;
+    }
+  return Eigen::Vector3d::UnitZ();
+}
+
+std::string axis_name(const Eigen::Vector3d& direction) {
+  int axis = 0;
+  direction.cwiseAbs().maxCoeff(&axis);
+  return std::string(direction[axis] < 0 ? "-" : "") + "xyz"[axis];
+}
+
+bool holds_or_retreats(const Scene& scene) {
+  const Tool& tool = scene.tools.front();
+  const Eigen::Vector3d d = advance_direction(scene);
+  Eigen::Vector3d from = tool.trajectory.start;
+  for (const TrajectorySegment& s : tool.trajectory.segments) {
+    if (s.kind != TrajectorySegment::Kind::move) return true;
+    if ((s.target - from).dot(d) < 0.0) return true;
+    from = s.target;
+  }
+  return !tool.trajectory.recorded_file.empty(); // a recorded hand: assume it does
 }
 
 void plot_stability(const std::filesystem::path& stem,

@@ -5,6 +5,8 @@
 #include "experiments/run/reference_run.hpp"
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/machine_label.hpp"
+#include "experiments/study/model_resolution.hpp"
 #include "experiments/study/reference_cache.hpp"
 
 #include <nlohmann/json.hpp>
@@ -147,6 +149,7 @@ struct ModelRun {
   std::filesystem::path dir;
   PhenomenonSet represented;   ///< what the model reproduces of the scene (represented_phenomena)
   std::string not_applicable;  ///< why the model cannot run on the scene (then it is not run)
+  bool anchors_fits = false;   ///< the model's fitted calibration row comes right after this one
 };
 
 /// One reference solve: a scene (possibly with another trajectory than its file's) at a mesh level
@@ -317,7 +320,23 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
         model_runs.push_back({index, model, model, scene, out / scene.name / model, {}, portable_note(std::string("not run: ") + e.what(), scene)});
         continue;
       }
-      model_runs.push_back({index, model, model, scene, out / scene.name / model, represented, ""});
+      const auto sweep = spec.resolutions.find(model);
+      if (sweep == spec.resolutions.end()) {
+        model_runs.push_back({index, model, model, scene, out / scene.name / model, represented, "", true});
+      } else {
+        // The model at each of its resolutions: the points of its speed/accuracy curve.
+        for (int value : sweep->second) {
+          try {
+            ModelResolution r = at_resolution(model, scene, value);
+            model_runs.push_back({index, model, r.label, std::move(r.scene), out / scene.name / r.directory, represented, "",
+                                  value == sweep->second.back()});
+          } catch (const ModelMismatch& e) {
+            model_runs.push_back({index, model, model, scene, out / scene.name / model, {},
+                                  portable_note(std::string("not run: ") + e.what(), scene), value == sweep->second.back()});
+            break;
+          }
+        }
+      }
       const auto calibrated = spec.calibrations.find(scene_file.stem().string());
       if (calibrated != spec.calibrations.end())
         for (const fs::path& parameters : calibrated->second) {
@@ -403,6 +422,9 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
   run_tasks(tasks, execution.jobs);
 
   StudyResult result;
+  result.machine = machine_label();
+  result.jobs = execution.jobs;
+  result.ranks = execution.ranks;
   result.reference_runs = synchronise(solved); // every reference is on disk: the fits may read theirs
   result.run_seconds = seconds_since(started);
 
@@ -459,15 +481,49 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     const Scene& scene = scenes[s].scene;
     std::map<int, ForceProfile> references;
+    SceneReference verified{scene.name, scene.tools.front().name, {}, {}, {}, std::nullopt, ""};
+    std::vector<ReferenceLevel> levels;
+    std::string failed_levels; // coarser levels that failed: the table goes on without them, saying so
     for (std::size_t k : scenes[s].levels) {
       const ReferenceSolve& solve = solves[k];
-      if (!fs::exists(solve.dir / "profile.csv"))
-        throw std::runtime_error("reference of scene " + scene.name + " at level " + std::to_string(solve.level) + " failed: " +
-                                 (fs::exists(solve.dir / "error.txt") ? read_text(solve.dir / "error.txt") : "no profile written"));
+      if (!fs::exists(solve.dir / "profile.csv")) {
+        const std::string why = "reference of scene " + scene.name + " at level " + std::to_string(solve.level) + " failed: " +
+                                (fs::exists(solve.dir / "error.txt") ? read_text(solve.dir / "error.txt") : "no profile written");
+        if (k == scenes[s].levels.back()) throw std::runtime_error(why); // the finest: nothing to score against
+        failed_levels += "L" + std::to_string(solve.level) + " failed (" + why.substr(why.find("failed: ") + 8) + "); ";
+        continue;
+      }
       references[solve.level] = read_profile_csv(solve.dir / "profile.csv");
+      verified.levels.push_back(solve.level);
+      verified.element_sizes.push_back(study_reference_element_size(scene, solve.level));
+      verified.profiles.push_back(solve.dir / "profile.csv");
+      levels.push_back({solve.level, verified.element_sizes.back(), references[solve.level]});
     }
     const ForceProfile* finest = references.empty() ? nullptr : &references.rbegin()->second;
     const std::string tool = scene.tools.front().name;
+
+    // The finest reference first, with its uncertainty: the solution verification of its three
+    // finest levels (reference_verification.hpp), or why there is none.
+    if (finest) {
+      const int finest_level = references.rbegin()->first;
+      try {
+        verified.verification = verify_reference(levels, tool);
+        verified.note = verified.verification ? verified.verification->summary()
+                                              : "no GCI available: " + std::to_string(levels.size()) +
+                                                    " mesh level(s), solution verification needs 3 ([reference] refinements)";
+      } catch (const std::exception& e) {
+        verified.note = std::string("no GCI available: ") + e.what();
+      }
+      verified.note = failed_levels + verified.note;
+      char size[64];
+      std::snprintf(size, sizeof size, "mesh h = %.3g mm; ", study_reference_element_size(scene, finest_level) * 1e3);
+      StudyRow row{scene.name, "reference L" + std::to_string(finest_level), std::nullopt, cost_statistics(*finest), size + verified.note, {}};
+      for (std::size_t k = 0; k < verified.levels.size(); ++k)
+        if (verified.levels[k] == finest_level) row.profile = verified.profiles[k];
+      result.rows.push_back(std::move(row));
+    }
+    const std::optional<double> rms_uncertainty = verified.verification ? verified.verification->rms_uncertainty() : std::nullopt;
+    const std::optional<double> peak_uncertainty = verified.verification ? verified.verification->peak_uncertainty() : std::nullopt;
 
     // The reference's own discretisation error: each coarser level against the finest.
     for (const auto& [level, profile] : references) {
@@ -475,7 +531,9 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       char note[160];
       std::snprintf(note, sizeof note, "mesh h = %.3g mm against the finest, L%d with h = %.3g mm", study_reference_element_size(scene, level) * 1e3,
                     references.rbegin()->first, study_reference_element_size(scene, references.rbegin()->first) * 1e3);
-      StudyRow row{scene.name, "reference L" + std::to_string(level), std::nullopt, cost_statistics(profile), note};
+      StudyRow row{scene.name, "reference L" + std::to_string(level), std::nullopt, cost_statistics(profile), note, {}};
+      for (std::size_t k = 0; k < verified.levels.size(); ++k)
+        if (verified.levels[k] == level) row.profile = verified.profiles[k];
       try {
         row.metrics = compare_profiles(at_common_times(profile, *finest), at_common_times(*finest, profile), tool);
       } catch (const std::exception& e) {
@@ -483,6 +541,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       }
       result.rows.push_back(std::move(row));
     }
+    if (finest) result.references.push_back(std::move(verified));
 
     // The model rows, each fitted calibration right after its model's plain row; a model that
     // cannot run on the scene has its row too, saying why.
@@ -491,11 +550,11 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       if (run.scene != s) continue;
       rows.emplace_back(run.label, run.dir, false, &run);
       for (const FitRun& fit : fit_runs)
-        if (fit.scene == s && fit.fit.model == run.model && run.label == run.model) rows.emplace_back(fit.label, fit.dir, true, &run);
+        if (fit.scene == s && fit.fit.model == run.model && run.anchors_fits) rows.emplace_back(fit.label, fit.dir, true, &run);
     }
     const auto join = [](const std::string& a, const std::string& b) { return a.empty() ? b : b.empty() ? a : a + "; " + b; };
     for (const auto& [label, dir, fitted, run] : rows) {
-      StudyRow row{scene.name, label, std::nullopt, {}, ""};
+      StudyRow row{scene.name, label, std::nullopt, {}, "", {}};
       if (!run->not_applicable.empty()) {
         row.note = run->not_applicable;
         result.rows.push_back(std::move(row));
@@ -509,6 +568,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
       if (fitted) row.note = read_text(dir / "calibration.txt");
       try {
         const ForceProfile profile = read_profile_csv(dir / "profile.csv");
+        row.profile = dir / "profile.csv";
         row.cost = cost_statistics(profile);
         if (finest) {
           // Scored only over the phases the model represents (springs on a blade: before the cut).
@@ -517,6 +577,14 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
           if (!scored.reference.rows.empty())
             row.metrics = compare_profiles(at_common_times(profile, scored.reference), at_common_times(scored.reference, profile),
                                            tool, expected_cutting(scene));
+          // An error the reference cannot resolve is not shown as a number (issue 21): compared in
+          // newtons with the uncertainty of the finest reference's RMS |F| and peak |F|.
+          if (row.metrics && rms_uncertainty)
+            row.rms_below_reference_uncertainty =
+                row.metrics->normalised_rms_force_error * row.metrics->reference_peak_force < *rms_uncertainty;
+          if (row.metrics && peak_uncertainty)
+            row.peak_below_reference_uncertainty =
+                std::abs(row.metrics->peak_force_error) * row.metrics->reference_peak_force < *peak_uncertainty;
         }
       } catch (const std::exception& e) {
         row.note = join(row.note, e.what());
@@ -541,12 +609,21 @@ StudyTable StudyResult::table() const {
                 {"max cost", "µs", 3, 1e6},
                 {"rate allowed", "kHz", 3, 1e-3},
                 {"note", "", 3, 1.0}});
+  t.group_by_first_column(true);
+  if (!machine.empty())
+    t.set_caption("Costs: wall time per servo step on " + machine + ", " + std::to_string(jobs) + " job(s)" +
+                   (ranks > 1 ? " × " + std::to_string(ranks) + " ranks" : std::string()) +
+                   (jobs * ranks > 1 ? " at once (a run beside others is slower; --jobs 1 for undisturbed costs)" : "") + ".");
   using O = std::optional<double>;
   for (const StudyRow& r : rows) {
     const bool m = r.metrics.has_value();
     const bool c = r.cost.steps > 0;
-    t.add_row({r.scene, r.model, m ? O(r.metrics->normalised_rms_force_error) : O(),
-               m ? O(r.metrics->peak_force_error) : O(), m ? r.metrics->rupture_displacement_error : O(),
+    using Cell = StudyTable::Cell;
+    const Cell rms = r.rms_below_reference_uncertainty ? Cell{std::string(below_reference_uncertainty)}
+                                                       : Cell{m ? O(r.metrics->normalised_rms_force_error) : O()};
+    const Cell peak = r.peak_below_reference_uncertainty ? Cell{std::string(below_reference_uncertainty)}
+                                                         : Cell{m ? O(r.metrics->peak_force_error) : O()};
+    t.add_row({r.scene, r.model, rms, peak, m ? r.metrics->rupture_displacement_error : O(),
                m ? r.metrics->steady_cutting_force_error : O(), m ? O(r.metrics->work_error) : O(),
                m ? O(r.metrics->mode_agreement) : O(), c ? O(r.cost.median) : O(), c ? O(r.cost.p99) : O(),
                c ? O(r.cost.max) : O(), c ? O(r.cost.rate_allowed()) : O(), r.note});

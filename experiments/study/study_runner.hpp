@@ -6,6 +6,7 @@
 #include "experiments/profile/force_profile.hpp"
 #include "experiments/run/run_model.hpp"
 #include "experiments/study/profile_metrics.hpp"
+#include "experiments/study/reference_verification.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "experiments/study/study_table.hpp"
 
@@ -29,18 +30,46 @@ using ReferenceRunner = std::function<ForceProfile(const Scene& scene, const Stu
 /// (study_reference_settings, reference_cache.hpp), no field files (`kerf reference` writes those).
 ReferenceRunner finite_element_reference();
 
-/// One row of the study table.
+/// One row of the study table. Each scene's rows: first its finest reference ("reference L<k>",
+/// no metrics, its note the solution verification or why there is none), then each coarser level
+/// against the finest ("reference L<k>"), then the fast models.
 struct StudyRow {
   std::string scene;
-  std::string model;                      ///< a fast model, or "reference L<k>" for a coarser level
+  std::string model;                      ///< a fast model, or "reference L<k>"
   std::optional<ProfileMetrics> metrics;  ///< against the finest reference (when there is one)
   CostStatistics cost;                    ///< per step [s]
   std::string note;                       ///< why a model did not run, or what was guarded
+  std::filesystem::path profile;          ///< the row's profile.csv (empty when it has none)
+  /// The model's RMS force difference [N] (normalised RMS error × the compared reference's peak
+  /// |F|) is below the reference's uncertainty in RMS |F| (GCI × RMS |F|, reference_verification.hpp):
+  /// the table shows "below reference uncertainty", not the number.
+  bool rms_below_reference_uncertainty = false;
+  /// |peak |F|_model - peak |F|_reference| [N] below the reference's uncertainty in peak |F|.
+  bool peak_below_reference_uncertainty = false;
+};
+
+/// The text a table shows instead of an error smaller than the reference's own uncertainty.
+inline constexpr const char* below_reference_uncertainty = "below reference uncertainty";
+
+/// A scene's reference as the study solved and verified it.
+struct SceneReference {
+  std::string scene;
+  std::string tool;                       ///< the scene's first tool: the one scored
+  std::vector<int> levels;                ///< mesh levels, coarsest first
+  std::vector<double> element_sizes;      ///< [m], per level
+  std::vector<std::filesystem::path> profiles; ///< profile.csv per level (in the cache)
+  std::optional<ReferenceVerification> verification; ///< with three levels or more
+  std::string note;                       ///< the reference row's note
 };
 
 struct StudyResult {
   std::vector<StudyRow> rows;
-  StudyTable table() const;   ///< the publishable table
+  std::vector<SceneReference> references; ///< one per scene with a reference, in study order
+  std::string machine;        ///< the machine the costs were measured on (machine_label.hpp)
+  int jobs = 1, ranks = 1;    ///< how the runs were spread (StudyExecution)
+  /// The publishable table, rows grouped by scene, with a caption naming the machine and the
+  /// jobs the costs were measured with.
+  StudyTable table() const;
   int reference_runs = 0;     ///< reference solves actually run (0 on a fully cached re-run)
   double run_seconds = 0.0;   ///< wall time of the reference solves and model runs (until every rank has them) [s]
   double fit_seconds = 0.0;   ///< wall time of the fitted calibrations ([[calibrate]]) [s]
@@ -72,7 +101,9 @@ struct StudyExecution {
 /// per solve named by reference_cache_key (reference_cache.hpp) with its `key.txt`. A fitted
 /// calibration's row "MODEL (calibrated)" comes right after MODEL's row, its note saying what was
 /// fitted on which trajectory; its parameter file is `out/SCENE/MODEL-calibrated/parameters.toml`. Rank 0 returns the rows; other
-/// ranks return no rows (and the total reference runs). Throws if a reference solve failed.
+/// ranks return no rows (and the total reference runs). Throws if a scene's finest reference solve
+/// failed; a coarser level that failed is left out, the reference row's note saying why (the
+/// solution verification then has the levels that remain).
 StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
                       const StudyExecution& execution = {});
 

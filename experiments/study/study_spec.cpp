@@ -2,6 +2,7 @@
 
 #include "experiments/calibration/free_parameters.hpp"
 #include "experiments/run/model_catalogue.hpp"
+#include "experiments/study/model_resolution.hpp"
 
 #include <toml++/toml.h>
 
@@ -58,7 +59,7 @@ StudySpec read_study(const std::filesystem::path& file) {
   }
   StudySpec spec;
   spec.file = file;
-  allow_only(file, doc, "", {"study", "reference", "calibration", "calibrate"});
+  allow_only(file, doc, "", {"study", "reference", "calibration", "calibrate", "models"});
   const toml::table* study = doc["study"].as_table();
   if (!study) throw StudyError(file.string() + ": missing table [study]");
   allow_only(file, *study, "study.", {"name", "description", "scenes", "models"});
@@ -120,6 +121,36 @@ StudySpec read_study(const std::filesystem::path& file) {
       else if (v == "auto") spec.reference.fracture = ReferenceFracture::automatic;
       else if (v == "on") spec.reference.fracture = ReferenceFracture::on;
       else fail(file, s.node()->source(), "reference.fracture", "expected \"off\", \"auto\" or \"on\"");
+    }
+  }
+  if (const toml::node* m = doc.get("models")) {
+    const toml::table* models = m->as_table();
+    if (!models) fail(file, m->source(), "models", "expected tables [models.NAME]");
+    for (const auto& [name, section] : *models) {
+      const std::string key = "models." + std::string(name.str());
+      if (std::find(spec.models.begin(), spec.models.end(), name.str()) == spec.models.end())
+        fail(file, name.source(), key, "expected a model of study.models");
+      const toml::table* t = section.as_table();
+      if (!t) fail(file, section.source(), key, "expected a table");
+      allow_only(file, *t, key + ".", {"resolutions"});
+      const toml::node* r = t->get("resolutions");
+      if (!r) continue;
+      std::pair<int, int> range;
+      try {
+        range = resolution_range(std::string(name.str()));
+      } catch (const std::invalid_argument& e) {
+        fail(file, r->source(), key + ".resolutions", e.what());
+      }
+      const std::string expected = "expected ascending integers in " + std::to_string(range.first) + ".." + std::to_string(range.second);
+      const toml::array* a = r->as_array();
+      if (!a || a->empty()) fail(file, r->source(), key + ".resolutions", expected);
+      std::vector<int>& values = spec.resolutions[std::string(name.str())];
+      for (const toml::node& n : *a) {
+        const auto v = n.value<int64_t>();
+        if (!v || *v < range.first || *v > range.second || (!values.empty() && *v <= values.back()))
+          fail(file, n.source(), key + ".resolutions", expected);
+        values.push_back(static_cast<int>(*v));
+      }
     }
   }
   if (const toml::node* c = doc.get("calibration")) {

@@ -16,6 +16,11 @@
 //   linear_solver = "auto"                         # "auto", "direct" or "iterative"
 //   fracture = "off"                               # cohesive fracture: "off", "auto" or "on"
 //
+//   [models.springs]                               # optional: a model at several resolutions,
+//   resolutions = [4, 8, 12]                       # one row "springs [N = 4]" … each (instead of the
+//                                                  # plain row): the points of its speed/accuracy
+//                                                  # curve (model_resolution.hpp: springs, voxel)
+//
 //   [calibration]                                  # optional: calibrated rows beside the others
 //   clay_pull = ["calibration/clay_pull.springs.toml"]   # parameter files (kerf calibrate -o),
 //                                                  # relative to the study file; every model a file
@@ -92,6 +97,9 @@ struct StudySpec {
   std::map<std::string, std::vector<std::filesystem::path>> calibrations;
   /// Calibrations fitted by the study ([[calibrate]]); each adds the row "MODEL (calibrated)".
   std::vector<StudyCalibrationFit> fits;
+  /// Resolutions per model ([models.NAME] resolutions, model_resolution.hpp), ascending and
+  /// distinct: the model runs once at each instead of once at the scene's own resolution.
+  std::map<std::string, std::vector<int>> resolutions;
 };
 
 class StudyError : public std::runtime_error {

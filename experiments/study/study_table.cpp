@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <fstream>
 #include <stdexcept>
+#include <string_view>
+#include <utility>
 
 namespace kerf {
 
@@ -21,17 +23,54 @@ std::string header(const StudyTable::Column& c) {
   return h;
 }
 
+/// LaTeX for the non-ASCII characters kerf's tables use (units, notes), so that the table
+/// compiles with pdflatex's default set-up (OT1, no inputenc declarations needed).
+constexpr std::pair<const char*, const char*> latex_unicode[] = {
+    {"µ", "\\textmu{}"},         {"×", "\\texttimes{}"},          {"≤", "\\ensuremath{\\le}"},
+    {"≥", "\\ensuremath{\\ge}"}, {"→", "\\ensuremath{\\to}"},    {"–", "--"},
+    {"—", "---"},                 {"φ", "\\ensuremath{\\varphi}"}, {"ε", "\\ensuremath{\\varepsilon}"},
+    {"δ", "\\ensuremath{\\delta}"}, {"σ", "\\ensuremath{\\sigma}"}, {"ν", "\\ensuremath{\\nu}"},
+    {"η", "\\ensuremath{\\eta}"},   {"μ", "\\ensuremath{\\mu}"},    {"Δ", "\\ensuremath{\\Delta}"},
+    {"±", "\\ensuremath{\\pm}"},    {"²", "\\textsuperscript{2}"}, {"°", "\\textdegree{}"},
+    {"…", "\\ldots{}"},           {"∞", "\\ensuremath{\\infty}"},
+};
+
 std::string latex_escape(const std::string& s) {
   std::string out;
-  for (char ch : s) {
+  for (std::size_t k = 0; k < s.size(); ++k) {
+    const char ch = s[k];
+    if (static_cast<unsigned char>(ch) >= 0x80) {
+      bool mapped = false;
+      for (const auto& [utf8, latex] : latex_unicode) {
+        const std::string_view u(utf8);
+        if (s.compare(k, u.size(), u) == 0) {
+          out += latex;
+          k += u.size() - 1;
+          mapped = true;
+          break;
+        }
+      }
+      if (!mapped) out += ch;
+      continue;
+    }
     switch (ch) {
     case '&': case '%': case '$': case '#': case '_': case '{': case '}': out += '\\'; out += ch; break;
     case '~': out += "\\textasciitilde{}"; break;
     case '^': out += "\\textasciicircum{}"; break;
     case '\\': out += "\\textbackslash{}"; break;
+    case '|': out += "\\textbar{}"; break; // OT1 sets "|" as an em dash
+    case '<': out += "\\textless{}"; break;
+    case '>': out += "\\textgreater{}"; break;
     default: out += ch;
     }
   }
+  return out;
+}
+
+/// A Markdown cell: a "|" in the text would end the cell ("RMS |F|").
+std::string markdown_cell(const std::string& s) {
+  std::string out;
+  for (char ch : s) out += ch == '|' ? std::string("\\|") : std::string(1, ch);
   return out;
 }
 
@@ -65,21 +104,27 @@ std::string StudyTable::shown(std::size_t column, const Cell& cell) const {
   return buffer;
 }
 
+bool StudyTable::numeric(std::size_t column) const {
+  for (const auto& row : m_rows)
+    if (std::holds_alternative<std::optional<double>>(row[column])) return true;
+  return false;
+}
+
 std::string StudyTable::markdown() const {
-  std::string out = "|";
+  std::string out = m_caption.empty() ? "|" : m_caption + "\n\n|";
   for (const Column& c : m_columns) {
     out += ' ';
-    out += header(c);
+    out += markdown_cell(header(c));
     out += " |";
   }
   out += "\n|";
-  for (std::size_t c = 0; c < m_columns.size(); ++c) out += std::holds_alternative<std::string>(m_rows.empty() ? Cell{std::string{}} : m_rows.front()[c]) ? "---|" : "---:|";
+  for (std::size_t c = 0; c < m_columns.size(); ++c) out += numeric(c) ? "---:|" : "---|";
   out += "\n";
   for (const auto& row : m_rows) {
     out += "|";
     for (std::size_t c = 0; c < row.size(); ++c) {
       out += ' ';
-      out += shown(c, row[c]);
+      out += markdown_cell(shown(c, row[c]));
       out += " |";
     }
     out += "\n";
@@ -90,23 +135,28 @@ std::string StudyTable::markdown() const {
 
 std::string StudyTable::latex() const {
   std::string spec;
-  for (std::size_t c = 0; c < m_columns.size(); ++c)
-    spec += (!m_rows.empty() && std::holds_alternative<std::string>(m_rows.front()[c])) ? "l" : "r";
+  for (std::size_t c = 0; c < m_columns.size(); ++c) spec += numeric(c) ? "r" : "l";
   std::string out = "\\begin{tabular}{" + spec + "}\n\\toprule\n";
   for (std::size_t c = 0; c < m_columns.size(); ++c) {
     if (c) out += " & ";
     out += latex_escape(header(m_columns[c]));
   }
   out += " \\\\\n\\midrule\n";
-  for (const auto& row : m_rows) {
+  for (std::size_t r = 0; r < m_rows.size(); ++r) {
+    const auto& row = m_rows[r];
+    const bool continues_group = m_grouped && r > 0 && shown(0, row[0]) == shown(0, m_rows[r - 1][0]);
+    if (m_grouped && r > 0 && !continues_group) out += "\\midrule\n";
     for (std::size_t c = 0; c < row.size(); ++c) {
-      const std::string cell = shown(c, row[c]);
+      const std::string cell = c == 0 && continues_group ? std::string() : shown(c, row[c]);
       if (c) out += " & ";
       out += cell == "–" ? std::string("--") : latex_escape(cell);
     }
     out += " \\\\\n";
   }
-  return out + "\\bottomrule\n\\end{tabular}\n";
+  out += "\\bottomrule\n";
+  if (!m_caption.empty())
+    out += "\\multicolumn{" + std::to_string(m_columns.size()) + "}{l}{\\footnotesize " + latex_escape(m_caption) + "} \\\\\n";
+  return out + "\\end{tabular}\n";
 }
 
 std::string StudyTable::csv() const {

@@ -27,12 +27,23 @@ public:
   /// Appends a row; its size must equal the column count (std::invalid_argument otherwise).
   void add_row(std::vector<Cell> row);
 
+  /// A line that goes with the table (e.g. the machine the costs were measured on): Markdown
+  /// prints it above the table (so that the file still ends with the table's last row), LaTeX as
+  /// a last full-width row under \bottomrule; CSV has no place for it (RFC 4180 has no comments)
+  /// and leaves it out.
+  void set_caption(std::string text) { m_caption = std::move(text); }
+  [[nodiscard]] const std::string& caption() const { return m_caption; }
+  /// Rows are grouped by their first column (the study's scenes) in the LaTeX form.
+  void group_by_first_column(bool grouped) { m_grouped = grouped; }
+
   [[nodiscard]] const std::vector<Column>& columns() const { return m_columns; }
   [[nodiscard]] std::size_t row_count() const { return m_rows.size(); }
 
   /// GitHub-flavoured Markdown, numbers right-aligned.
   [[nodiscard]] std::string markdown() const;
-  /// A LaTeX tabular with \toprule/\midrule/\bottomrule (booktabs); text escaped for LaTeX.
+  /// A LaTeX tabular with \toprule/\midrule/\bottomrule (booktabs); text escaped for LaTeX. With
+  /// group_by_first_column: a \midrule between groups of rows with the same first cell, that cell
+  /// shown on the group's first row only.
   [[nodiscard]] std::string latex() const;
   /// RFC 4180 CSV at full precision (17 digits) in the column's unit, header "name [unit]"; an
   /// unmeasured number is an empty field.
@@ -43,6 +54,10 @@ public:
 
 private:
   [[nodiscard]] std::string shown(std::size_t column, const Cell& cell) const;
+  /// A column holding at least one number (right-aligned), else text.
+  [[nodiscard]] bool numeric(std::size_t column) const;
+  std::string m_caption;
+  bool m_grouped = false;
   std::vector<Column> m_columns;
   std::vector<std::vector<Cell>> m_rows;
 };

@@ -68,3 +68,39 @@ TEST(Recommend, FindsTablesAndRejectsMalformedOnes) {
     EXPECT_NE(std::string(e.what()).find("bad2.csv:2:"), std::string::npos) << e.what();
   }
 }
+
+TEST(Recommend, AnErrorBelowTheReferenceUncertaintyMeetsTheBudget) {
+  // A row whose error the reference cannot resolve ("below reference uncertainty", study_runner.hpp)
+  // meets any error budget: at 1 kHz within 5 % it is the only choice; cheaper rows that err more lose.
+  const fs::path dir = fs::temp_directory_path() / ("kerf_test_recommend_below_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "study.csv") << "scene,model,RMS force error [%],p99 cost [µs],note\n"
+                                      "potato,reference L1,,3000,GCI 1 %\n"
+                                      "potato,fine,below reference uncertainty,400,\n"
+                                      "potato,coarse,12,50,\n";
+  const auto rows = read_study_rows(dir / "study.csv");
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_TRUE(rows[1].below_reference_uncertainty);
+  const Recommendation r = recommend_model(rows, "potato", 0.05, 1000.0);
+  ASSERT_TRUE(r.choice.has_value()) << r.reason;
+  EXPECT_EQ(r.choice->model, "fine");
+  EXPECT_NE(r.reason.find("below the reference's uncertainty"), std::string::npos) << r.reason;
+  EXPECT_EQ(recommend_model(rows, "potato", 0.15, 1000.0).choice->model, "coarse"); // cheaper, within 15 %
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Recommend, AnswersFromAModelsResolutionCurve) {
+  // A model at three resolutions ([models.springs] resolutions, one row each): error falls and cost
+  // rises with N. Within 10 % at 1 kHz, N = 4 errs too much and N = 12 is too slow: N = 8.
+  const fs::path dir = fs::temp_directory_path() / ("kerf_test_recommend_curve_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "study.csv") << "scene,model,RMS force error [%],p99 cost [µs],note\n"
+                                      "clay,springs [N = 4],12,50,\n"
+                                      "clay,springs [N = 8],6,400,\n"
+                                      "clay,springs [N = 12],4,1500,\n";
+  const auto rows = read_study_rows(dir / "study.csv");
+  EXPECT_EQ(recommend_model(rows, "clay", 0.10, 1000.0).choice->model, "springs [N = 8]");
+  EXPECT_EQ(recommend_model(rows, "clay", 0.15, 10000.0).choice->model, "springs [N = 4]"); // 100 µs budget
+  EXPECT_EQ(recommend_model(rows, "clay", 0.05, 500.0).choice->model, "springs [N = 12]");  // 2 ms budget
+  std::filesystem::remove_all(dir);
+}

@@ -2,6 +2,8 @@
 // selection, subsampling, and a run of two scenes end to end.
 
 #include "experiments/study/study_runner.hpp"
+#include "experiments/study/model_resolution.hpp"
+#include "experiments/study/study_report.hpp"
 
 #include "experiments/run/model_catalogue.hpp"
 #include "experiments/run/scene_mesh.hpp"
@@ -15,6 +17,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <set>
+#include <sstream>
 
 #include <unistd.h>
 
@@ -233,8 +236,8 @@ TEST(StudyRunner, EndToEndWithTheReferenceAndItsCache) {
       EXPECT_EQ(row.metrics->samples, 4u);
       scored = true;
     }
-    if (row.scene == "potato_wedge_cut") { // springs there: the blade's deformation phase
-      EXPECT_TRUE(row.model == "fracture" || row.model == "springs") << row.model;
+    if (row.scene == "potato_wedge_cut") { // its reference first; springs there: the blade's deformation phase
+      EXPECT_TRUE(row.model == "reference L0" || row.model == "fracture" || row.model == "springs") << row.model;
     }
   }
   EXPECT_TRUE(scored);
@@ -304,10 +307,11 @@ TEST(StudyRunner, ParallelRunsGiveTheSerialTablesApartFromCosts) {
   fs::remove_all(b);
   const StudyResult one = run_study(spec, a, fake, serial);
   const StudyResult three = run_study(spec, b, fake, parallel);
-  // 2 x (fracture, edge, springs: the blade's deformation phase) + fracture (calibrated).
-  ASSERT_EQ(one.rows.size(), 7u);
-  EXPECT_EQ(one.rows[1].model, "fracture (calibrated)");
-  EXPECT_TRUE(one.rows[0].metrics.has_value());
+  // 2 x (reference L0, fracture, edge, springs: the blade's deformation phase) + fracture (calibrated).
+  ASSERT_EQ(one.rows.size(), 9u);
+  EXPECT_EQ(one.rows[0].model, "reference L0");
+  EXPECT_EQ(one.rows[2].model, "fracture (calibrated)");
+  EXPECT_TRUE(one.rows[1].metrics.has_value());
   EXPECT_EQ(one.reference_runs, 2);
   EXPECT_EQ(three.reference_runs, 2);
   const std::string csv_one = one.table().csv(), csv_three = three.table().csv();
@@ -343,7 +347,7 @@ TEST(StudyRunner, ParallelRunsGiveTheSerialTablesApartFromCosts) {
   // Calibrated parameters (f_r 350 instead of 300 N/m) change the fracture model's deformation-1 samples
   // (40 samples over the 22.5 s trajectory: one per 0.58 mm of cut, two or three within δ_r = 1.5 mm),
   // so its row differs from the plain one, which is the fake reference itself (error 0).
-  EXPECT_NE(one.rows[0].metrics->normalised_rms_force_error, one.rows[1].metrics->normalised_rms_force_error);
+  EXPECT_NE(one.rows[1].metrics->normalised_rms_force_error, one.rows[2].metrics->normalised_rms_force_error);
 }
 
 TEST(StudySpec, ReadsSolverSettingsAndFittedCalibrations) {
@@ -480,15 +484,17 @@ TEST(StudyRunner, ACoarseLevelIsItsOwnSolveOnTheCoarserMesh) {
   ASSERT_EQ(sizes.size(), 2u);
   EXPECT_DOUBLE_EQ(sizes[0], 4e-3);
   EXPECT_DOUBLE_EQ(sizes[1], 2e-3);
-  ASSERT_GE(r.rows.size(), 2u);
-  EXPECT_EQ(r.rows[0].model, "reference L-1");
-  ASSERT_TRUE(r.rows[0].metrics.has_value()) << r.rows[0].note;
-  ASSERT_GT(finest_peak, 0.0);
-  EXPECT_NEAR(r.rows[0].metrics->normalised_rms_force_error, 1.0 / finest_peak, 1e-9);
-  EXPECT_NE(r.rows[0].note.find("h = 4 mm"), std::string::npos) << r.rows[0].note;
-  EXPECT_EQ(r.rows[1].model, "fracture");
+  ASSERT_GE(r.rows.size(), 3u);
+  EXPECT_EQ(r.rows[0].model, "reference L0"); // the finest first; two levels: no GCI, and its note says so
+  EXPECT_NE(r.rows[0].note.find("no GCI available"), std::string::npos) << r.rows[0].note;
+  EXPECT_EQ(r.rows[1].model, "reference L-1");
   ASSERT_TRUE(r.rows[1].metrics.has_value()) << r.rows[1].note;
-  EXPECT_NEAR(r.rows[1].metrics->normalised_rms_force_error, 0.0, 1e-12); // the finest is the model itself
+  ASSERT_GT(finest_peak, 0.0);
+  EXPECT_NEAR(r.rows[1].metrics->normalised_rms_force_error, 1.0 / finest_peak, 1e-9);
+  EXPECT_NE(r.rows[1].note.find("h = 4 mm"), std::string::npos) << r.rows[1].note;
+  EXPECT_EQ(r.rows[2].model, "fracture");
+  ASSERT_TRUE(r.rows[2].metrics.has_value()) << r.rows[2].note;
+  EXPECT_NEAR(r.rows[2].metrics->normalised_rms_force_error, 0.0, 1e-12); // the finest is the model itself
   EXPECT_EQ(std::distance(fs::directory_iterator(out / "cache"), fs::directory_iterator{}), 2);
   EXPECT_EQ(run_study(spec, out, offset).reference_runs, 0); // both cached
   fs::remove_all(out);
@@ -508,16 +514,17 @@ TEST(StudyRunner, AFittedCalibrationIsScoredOnTheHeldOutTrajectory) {
   std::atomic<int> solves{0};
   const StudyResult r = run_study(spec, dir, fracture_as_reference(solves, 500.0));
   EXPECT_EQ(r.reference_runs, 2); // the scene's trajectory, and the calibration trajectory
-  ASSERT_EQ(r.rows.size(), 3u);
-  EXPECT_EQ(r.rows[0].model, "fracture");
-  EXPECT_EQ(r.rows[1].model, "fracture (calibrated)"); // right after its model
-  EXPECT_EQ(r.rows[2].model, "edge");
-  ASSERT_TRUE(r.rows[0].metrics && r.rows[1].metrics) << r.rows[1].note;
-  EXPECT_GT(r.rows[0].metrics->normalised_rms_force_error, 0.05);
-  EXPECT_LT(r.rows[1].metrics->normalised_rms_force_error, 0.5 * r.rows[0].metrics->normalised_rms_force_error);
-  EXPECT_EQ(r.rows[1].metrics->samples, 40u); // scored on the scene's own 40 samples
-  EXPECT_NE(r.rows[1].note.find("fitted at speed ×2"), std::string::npos) << r.rows[1].note;
-  EXPECT_NE(r.rows[1].note.find("f_r 300 → "), std::string::npos) << r.rows[1].note;
+  ASSERT_EQ(r.rows.size(), 4u);
+  EXPECT_EQ(r.rows[0].model, "reference L0");
+  EXPECT_EQ(r.rows[1].model, "fracture");
+  EXPECT_EQ(r.rows[2].model, "fracture (calibrated)"); // right after its model
+  EXPECT_EQ(r.rows[3].model, "edge");
+  ASSERT_TRUE(r.rows[1].metrics && r.rows[2].metrics) << r.rows[2].note;
+  EXPECT_GT(r.rows[1].metrics->normalised_rms_force_error, 0.05);
+  EXPECT_LT(r.rows[2].metrics->normalised_rms_force_error, 0.5 * r.rows[1].metrics->normalised_rms_force_error);
+  EXPECT_EQ(r.rows[2].metrics->samples, 40u); // scored on the scene's own 40 samples
+  EXPECT_NE(r.rows[2].note.find("fitted at speed ×2"), std::string::npos) << r.rows[2].note;
+  EXPECT_NE(r.rows[2].note.find("f_r 300 → "), std::string::npos) << r.rows[2].note;
   // The parameter file recovers the truth (f_r = 500 N/m; δ_r, δ_c as in the scene), within 3 %:
   // ten runs per simplex search stop it short of its 0.1 % tolerance (measured: 494.6 N/m).
   const fs::path parameters = dir / "potato_rect_cut" / "fracture-calibrated" / "parameters.toml";
@@ -527,9 +534,9 @@ TEST(StudyRunner, AFittedCalibrationIsScoredOnTheHeldOutTrajectory) {
   // Re-run: both references from the cache, the same fit.
   const StudyResult again = run_study(spec, dir, fracture_as_reference(solves, 500.0));
   EXPECT_EQ(again.reference_runs, 0);
-  ASSERT_EQ(again.rows.size(), 3u);
-  ASSERT_TRUE(again.rows[1].metrics.has_value());
-  EXPECT_EQ(again.rows[1].metrics->normalised_rms_force_error, r.rows[1].metrics->normalised_rms_force_error);
+  ASSERT_EQ(again.rows.size(), 4u);
+  ASSERT_TRUE(again.rows[2].metrics.has_value());
+  EXPECT_EQ(again.rows[2].metrics->normalised_rms_force_error, r.rows[2].metrics->normalised_rms_force_error);
 }
 
 TEST(StudyRunner, AFitAgainstAForcelessReferenceSaysWhy) {
@@ -555,10 +562,10 @@ TEST(StudyRunner, AFitAgainstAForcelessReferenceSaysWhy) {
     return p;
   };
   const StudyResult r = run_study(spec, dir, forceless);
-  ASSERT_EQ(r.rows.size(), 2u);
-  EXPECT_EQ(r.rows[1].model, "fracture (calibrated)");
-  EXPECT_FALSE(r.rows[1].metrics.has_value());
-  EXPECT_EQ(r.rows[1].note.rfind("not calibrated: ", 0), 0u) << r.rows[1].note;
+  ASSERT_EQ(r.rows.size(), 3u); // reference L0, fracture, fracture (calibrated)
+  EXPECT_EQ(r.rows[2].model, "fracture (calibrated)");
+  EXPECT_FALSE(r.rows[2].metrics.has_value());
+  EXPECT_EQ(r.rows[2].note.rfind("not calibrated: ", 0), 0u) << r.rows[2].note;
 }
 
 TEST(StudyRunner, NoFitToTheUncutReferenceOfACuttingScene) {
@@ -574,10 +581,10 @@ TEST(StudyRunner, NoFitToTheUncutReferenceOfACuttingScene) {
   std::atomic<int> solves{0};
   const StudyResult r = run_study(spec, dir, fracture_as_reference(solves, 500.0));
   EXPECT_EQ(r.reference_runs, 1);
-  ASSERT_EQ(r.rows.size(), 2u);
-  EXPECT_EQ(r.rows[1].model, "fracture (calibrated)");
-  EXPECT_FALSE(r.rows[1].metrics.has_value());
-  EXPECT_EQ(r.rows[1].note.rfind("not calibrated: scene potato_rect_cut cuts or tears", 0), 0u) << r.rows[1].note;
+  ASSERT_EQ(r.rows.size(), 3u); // reference L0, fracture, fracture (calibrated)
+  EXPECT_EQ(r.rows[2].model, "fracture (calibrated)");
+  EXPECT_FALSE(r.rows[2].metrics.has_value());
+  EXPECT_EQ(r.rows[2].note.rfind("not calibrated: scene potato_rect_cut cuts or tears", 0), 0u) << r.rows[2].note;
 }
 
 TEST(StudyRunner, TheCalibrationTrajectoryIsTheSamePathPlayedFaster) {
@@ -605,4 +612,87 @@ TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
     EXPECT_NE(f.speed, 1.0); // the scene's own trajectory stays held out
   }
   EXPECT_EQ(fits, (std::set<std::pair<std::string, std::string>>{{"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}}));
+}
+
+TEST(StudySpec, ReadsModelResolutions) {
+  const StudySpec s = read_study(write_study("res.toml", "[study]\nname = \"t\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\", \"edge\"]\n"
+                                                         "[models.springs]\nresolutions = [2, 4, 8]\n"));
+  EXPECT_EQ(s.resolutions.at("springs"), (std::vector<int>{2, 4, 8}));
+  const std::string head = "[study]\nname = \"t\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\", \"edge\"]\n";
+  const std::pair<std::string, std::string> cases[] = {
+      {head + "[models.springs]\nresolutions = [4, 2]\n", ":6:19: models.springs.resolutions"},  // not ascending
+      {head + "[models.springs]\nresolutions = [0]\n", ":6:16: models.springs.resolutions"},     // below 1
+      {head + "[models.edge]\nresolutions = [2]\n", ":6:15: models.edge.resolutions: model edge has no resolution"},
+      {head + "[models.voxel]\nresolutions = [2]\n", ":5:9: models.voxel: expected a model of study.models"},
+      {head + "[models.springs]\ncells = [2]\n", ":6:9: models.springs.cells"},
+  };
+  int k = 0;
+  for (const auto& [text, expected] : cases) {
+    const fs::path f = write_study("bad_res" + std::to_string(k++) + ".toml", text);
+    try {
+      read_study(f);
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const StudyError& e) {
+      EXPECT_NE(std::string(e.what()).find(f.string() + expected), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(ModelResolution, SetsEachModelsKnobOnTheScene) {
+  // Springs: N cells per side; a scene that fixes the cell size (clay_tear: 12 cells of 5 mm) keeps
+  // its block's 60 mm extent. Voxel: paper 002's 10 × 20 × 20 grid scaled to n along its first axis.
+  const Scene clay = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
+  const ModelResolution four = at_resolution("springs", clay, 4);
+  EXPECT_EQ(four.scene.springs->cells, 4);
+  EXPECT_EQ(four.label, "springs [N = 4]");
+  const Scene tear = read_scene(fs::path(KERF_SCENES_DIR) / "clay_tear.toml");
+  ASSERT_TRUE(tear.springs && tear.springs->cells && tear.springs->cell_size);
+  const ModelResolution six = at_resolution("springs", tear, 6);
+  EXPECT_NEAR(*six.scene.springs->cell_size * 6, *tear.springs->cell_size * *tear.springs->cells, 1e-15);
+  const Scene sponge = read_scene(fs::path(KERF_SCENES_DIR) / "sponge_cut_proportional.toml");
+  ASSERT_TRUE(sponge.voxel.has_value());
+  EXPECT_EQ(sponge.voxel->grid, (std::array<int, 3>{10, 20, 20}));
+  const ModelResolution five = at_resolution("voxel", sponge, 5);
+  EXPECT_EQ(five.scene.voxel->grid, (std::array<int, 3>{5, 10, 10}));
+  EXPECT_EQ(five.label, "voxel [grid 5×10×10]");
+  EXPECT_THROW(at_resolution("voxel", clay, 5), ModelMismatch); // no [models.voxel]
+  EXPECT_THROW(at_resolution("edge", clay, 5), std::invalid_argument);
+  EXPECT_THROW(at_resolution("springs", clay, 0), std::invalid_argument);
+}
+
+TEST(StudyRunner, AModelRunsAtEachOfItsResolutions) {
+  // [models.springs] resolutions = [2, 3]: two rows instead of the plain one, each built with its N
+  // (the run's manifest records the network the builder made: cells_per_side), each with a profile.
+  const StudySpec spec = read_study(write_study(
+      "sweep.toml", "[study]\nname = \"sweep\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n[models.springs]\nresolutions = [2, 3]\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_sweep_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const StudyResult r = run_study(spec, out, {});
+  ASSERT_EQ(r.rows.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    const int n = 2 + k;
+    EXPECT_EQ(r.rows[k].model, "springs [N = " + std::to_string(n) + "]");
+    EXPECT_GT(r.rows[k].cost.steps, 0u) << r.rows[k].note;
+    ASSERT_TRUE(fs::exists(r.rows[k].profile));
+    std::ifstream manifest(r.rows[k].profile.parent_path() / "manifest.json");
+    std::stringstream text;
+    text << manifest.rdbuf();
+    EXPECT_NE(text.str().find("\"cells_per_side\": " + std::to_string(n)), std::string::npos) << text.str().substr(0, 400);
+  }
+  // Both are drawn, by their labels (which hold "="), in the scene's profile plot.
+  write_study_report(spec, r, out);
+  std::ifstream plotted(out / "clay_pull_profiles.csv");
+  std::stringstream data;
+  data << plotted.rdbuf();
+  for (const char* label : {",springs [N = 2],", ",springs [N = 3],"}) EXPECT_NE(data.str().find(label), std::string::npos) << label;
+  fs::remove_all(out);
+}
+
+TEST(StudySpec, TheFullStudyVerifiesItsReferenceAndSweepsTheSprings) {
+  // experiments/studies/full.toml: three mesh levels (the GCI needs three) and a resolution curve.
+  const StudySpec s = read_study(fs::path(KERF_STUDIES_DIR) / "full.toml");
+  ASSERT_TRUE(s.has_reference);
+  EXPECT_GE(s.reference.refinements.size(), 3u);
+  ASSERT_TRUE(s.resolutions.count("springs"));
+  EXPECT_GE(s.resolutions.at("springs").size(), 2u);
 }

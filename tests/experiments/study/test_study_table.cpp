@@ -1,6 +1,7 @@
 // StudyTable's three forms against hand-written expected text.
 
 #include "experiments/study/study_table.hpp"
+#include "experiments/study/machine_label.hpp"
 
 #include <gtest/gtest.h>
 
@@ -28,7 +29,7 @@ TEST(StudyTable, Markdown) {
 
 TEST(StudyTable, LatexBooktabsEscapesText) {
   EXPECT_EQ(example().latex(), "\\begin{tabular}{lrr}\n\\toprule\n"
-                               "model & RMS error [\\%] & p99 cost [µs] \\\\\n\\midrule\n"
+                               "model & RMS error [\\%] & p99 cost [\\textmu{}s] \\\\\n\\midrule\n"
                                "fracture & 1.23 & 4.2 \\\\\n"
                                "springs\\_a\\&b & -- & 1.5e+02 \\\\\n"
                                "\\bottomrule\n\\end{tabular}\n");
@@ -60,4 +61,48 @@ TEST(StudyTable, RowsMustMatchColumnsAndFilesAreWritten) {
   std::stringstream text;
   text << md.rdbuf();
   EXPECT_EQ(text.str(), t.markdown());
+}
+
+TEST(StudyTable, GroupsByTheFirstColumnTextInANumericColumnAndACaption) {
+  // Rows of two scenes: LaTeX rules off each scene's group and names the scene once; a numeric
+  // column may hold text ("below reference uncertainty") and stays right-aligned; the
+  // caption (the machine of the cost columns) precedes the table in Markdown (the file still ends
+  // with the last row), follows it in LaTeX, and is not in CSV.
+  StudyTable t({{"scene", "", 3, 1.0}, {"model", "", 3, 1.0}, {"RMS error", "%", 3, 100.0}});
+  t.add_row({std::string("a"), std::string("reference L1"), std::optional<double>()});
+  t.add_row({std::string("a"), std::string("springs"), std::string("below reference uncertainty")});
+  t.add_row({std::string("b"), std::string("edge"), std::optional<double>(0.5)});
+  t.set_caption("Costs on: Test CPU, 2 cores");
+  t.group_by_first_column(true);
+  EXPECT_EQ(t.markdown(), "Costs on: Test CPU, 2 cores\n\n"
+                          "| scene | model | RMS error [%] |\n"
+                          "|---|---|---:|\n"
+                          "| a | reference L1 | – |\n"
+                          "| a | springs | below reference uncertainty |\n"
+                          "| b | edge | 50 |\n");
+  EXPECT_EQ(t.latex(), "\\begin{tabular}{llr}\n\\toprule\n"
+                       "scene & model & RMS error [\\%] \\\\\n\\midrule\n"
+                       "a & reference L1 & -- \\\\\n"
+                       " & springs & below reference uncertainty \\\\\n"
+                       "\\midrule\n"
+                       "b & edge & 50 \\\\\n"
+                       "\\bottomrule\n"
+                       "\\multicolumn{3}{l}{\\footnotesize Costs on: Test CPU, 2 cores} \\\\\n"
+                       "\\end{tabular}\n");
+  EXPECT_EQ(t.csv(), "scene,model,RMS error [%]\na,reference L1,\na,springs,below reference uncertainty\nb,edge,50\n");
+  // A "|" in a cell ("GCI on RMS |F|") is escaped in Markdown, or it would end the cell.
+  StudyTable pipes({{"note", "", 3, 1.0}});
+  pipes.add_row({std::string("GCI 1 % on RMS |F|")});
+  EXPECT_EQ(pipes.markdown(), "| note |\n|---|\n| GCI 1 % on RMS \\|F\\| |\n");
+}
+
+TEST(MachineLabel, ReadsTheCpuModelFromCpuinfo) {
+  // Two excerpts in the kernel's /proc/cpuinfo format: x86 ("model name") and an older ARM kernel
+  // ("Processor", "Hardware"); a text without either names no model.
+  EXPECT_EQ(cpu_model_name("processor\t: 0\nvendor_id\t: GenuineIntel\nmodel name\t: Intel(R) Xeon(R) CPU @ 2.20GHz\n"
+                           "processor\t: 1\nmodel name\t: Intel(R) Xeon(R) CPU @ 2.20GHz\n"),
+            "Intel(R) Xeon(R) CPU @ 2.20GHz");
+  EXPECT_EQ(cpu_model_name("Processor\t: ARMv7 Processor rev 4 (v7l)\nHardware\t: BCM2835\n"), "BCM2835");
+  EXPECT_EQ(cpu_model_name("processor\t: 0\n"), "");
+  EXPECT_NE(machine_label().find(" core"), std::string::npos);
 }

@@ -1,0 +1,134 @@
+#include "experiments/study/reference_verification.hpp"
+
+#include "experiments/study/study_runner.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace kerf {
+
+namespace {
+
+std::vector<const ProfileRow*> rows_of(const ForceProfile& p, const std::string& tool) {
+  std::vector<const ProfileRow*> rows;
+  for (const ProfileRow& r : p.rows)
+    if (r.tool == tool) rows.push_back(&r);
+  return rows;
+}
+
+/// Finest first.
+std::vector<const ReferenceLevel*> by_element_size(const std::vector<ReferenceLevel>& levels) {
+  std::vector<const ReferenceLevel*> sorted;
+  for (const ReferenceLevel& l : levels) sorted.push_back(&l);
+  std::sort(sorted.begin(), sorted.end(), [](const ReferenceLevel* a, const ReferenceLevel* b) { return a->element_size < b->element_size; });
+  return sorted;
+}
+
+/// The row of `rows` at time t (to 1e-9 s), or null.
+const ProfileRow* at_time(const std::vector<const ProfileRow*>& rows, double t) {
+  const auto it = std::lower_bound(rows.begin(), rows.end(), t - 1e-9, [](const ProfileRow* r, double v) { return r->t < v; });
+  return it != rows.end() && (*it)->t <= t + 1e-9 ? *it : nullptr;
+}
+
+std::string describe(const char* name, double value, const GridConvergence& c) {
+  char text[400];
+  if (!c.usable()) {
+    std::snprintf(text, sizeof text, "no GCI on %s = %.3g N: %s", name, value, c.unusable.c_str());
+    return text;
+  }
+  std::snprintf(text, sizeof text, "GCI %.2g %% on %s = %.3g N (p = %.2g%s, extrapolated %.3g N)", 100.0 * *c.gci_fine, name, value,
+                *c.observed_order, c.oscillatory ? ", oscillatory convergence" : "", *c.extrapolated);
+  return text;
+}
+
+} // namespace
+
+std::optional<double> ReferenceVerification::rms_uncertainty() const {
+  if (!rms.usable()) return std::nullopt;
+  return *rms.gci_fine * std::abs(rms_force);
+}
+
+std::optional<double> ReferenceVerification::peak_uncertainty() const {
+  if (!peak.usable()) return std::nullopt;
+  return *peak.gci_fine * std::abs(peak_force);
+}
+
+std::string ReferenceVerification::summary() const {
+  char where[200];
+  std::snprintf(where, sizeof where, "; from L%d, L%d, L%d (h = %.3g, %.3g, %.3g mm) on %zu common samples", levels[0], levels[1], levels[2],
+                element_sizes[0] * 1e3, element_sizes[1] * 1e3, element_sizes[2] * 1e3, samples);
+  return describe("RMS |F|", rms_force, rms) + "; " + describe("peak |F|", peak_force, peak) + where;
+}
+
+std::optional<ReferenceVerification> verify_reference(const std::vector<ReferenceLevel>& levels, const std::string& tool) {
+  if (levels.size() < 3) return std::nullopt;
+  const auto sorted = by_element_size(levels);
+  // The samples all three finest levels solved.
+  ForceProfile common[3] = {sorted[0]->profile, sorted[1]->profile, sorted[2]->profile};
+  for (int pass = 0; pass < 2; ++pass)
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        if (a != b) common[a] = at_common_times(common[a], common[b]);
+  ReferenceVerification v;
+  double rms[3], peak[3];
+  for (int k = 0; k < 3; ++k) {
+    v.levels[k] = sorted[k]->level;
+    v.element_sizes[k] = sorted[k]->element_size;
+    const auto rows = rows_of(common[k], tool);
+    if (rows.size() < 2)
+      throw std::invalid_argument("reference verification: the three finest levels (L" + std::to_string(sorted[0]->level) + ", L" +
+                                  std::to_string(sorted[1]->level) + ", L" + std::to_string(sorted[2]->level) + ") share " +
+                                  std::to_string(rows.size()) + " sample(s) of tool " + tool + ", fewer than 2");
+    v.samples = rows.size();
+    double sum = 0.0;
+    peak[k] = 0.0;
+    for (const ProfileRow* r : rows) {
+      sum += r->force.squaredNorm();
+      peak[k] = std::max(peak[k], r->force.norm());
+    }
+    rms[k] = std::sqrt(sum / static_cast<double>(rows.size()));
+  }
+  v.rms_force = rms[0];
+  v.peak_force = peak[0];
+  v.rms = grid_convergence({v.element_sizes[0], v.element_sizes[1], v.element_sizes[2], rms[0], rms[1], rms[2]});
+  v.peak = grid_convergence({v.element_sizes[0], v.element_sizes[1], v.element_sizes[2], peak[0], peak[1], peak[2]});
+  return v;
+}
+
+ReferenceBand reference_band(const std::vector<ReferenceLevel>& levels, const std::optional<ReferenceVerification>& verification,
+                             const std::string& tool, const Eigen::Vector3d& direction) {
+  ReferenceBand band;
+  if (levels.empty()) return band;
+  const auto sorted = by_element_size(levels);
+  const auto resisting = [&](const ProfileRow* r) { return -r->force.dot(direction); };
+  const auto fine = rows_of(sorted[0]->profile, tool);
+  std::vector<std::vector<const ProfileRow*>> others;
+  for (std::size_t k = 1; k < sorted.size(); ++k) others.push_back(rows_of(sorted[k]->profile, tool));
+  band.from_gci = verification && verification->rms.usable() && sorted.size() >= 2;
+  for (const ProfileRow* r : fine) {
+    const double f1 = resisting(r);
+    const ProfileRow* medium = others.empty() ? nullptr : at_time(others.front(), r->t);
+    if (band.from_gci && medium) {
+      const double u = gci_band_half_width({f1}, {resisting(medium)}, sorted[1]->element_size / sorted[0]->element_size,
+                                           *verification->rms.observed_order)
+                           .front();
+      band.low.push_back(f1 - u);
+      band.high.push_back(f1 + u);
+      continue;
+    }
+    double low = f1, high = f1;
+    for (const auto& rows : others)
+      if (const ProfileRow* o = at_time(rows, r->t)) {
+        low = std::min(low, resisting(o));
+        high = std::max(high, resisting(o));
+      }
+    band.low.push_back(low);
+    band.high.push_back(high);
+  }
+  return band;
+}
+
+} // namespace kerf

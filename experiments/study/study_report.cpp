@@ -1,0 +1,119 @@
+#include "experiments/study/study_report.hpp"
+
+#include "experiments/scene/scene_reader.hpp"
+#include "experiments/study/study_plots.hpp"
+
+#include "meshes/atomic_file.hpp"
+
+#include <cstdio>
+#include <fstream>
+
+namespace kerf {
+
+std::optional<double> rms_error_floor(const SceneReference& reference) {
+  if (!reference.verification) return std::nullopt;
+  const auto u = reference.verification->rms_uncertainty();
+  if (!u || !(reference.verification->peak_force > 0.0)) return std::nullopt;
+  return *u / reference.verification->peak_force;
+}
+
+StudyTable verification_table(const StudyResult& result) {
+  StudyTable t({{"scene", "", 3, 1.0},           {"quantity", "", 3, 1.0},        {"levels", "", 3, 1.0},
+                {"h1", "mm", 3, 1e3},             {"h2", "mm", 3, 1e3},            {"h3", "mm", 3, 1e3},
+                {"φ1", "N", 5, 1.0},              {"φ2", "N", 5, 1.0},             {"φ3", "N", 5, 1.0},
+                {"r21", "", 3, 1.0},              {"r32", "", 3, 1.0},             {"observed order p", "", 3, 1.0},
+                {"convergence", "", 3, 1.0},      {"extrapolated", "N", 5, 1.0},   {"e_a", "%", 3, 100.0},
+                {"e_ext", "%", 3, 100.0},         {"GCI_fine", "%", 3, 100.0},     {"note", "", 3, 1.0}});
+  using O = std::optional<double>;
+  for (const SceneReference& r : result.references) {
+    if (!r.verification) {
+      t.add_row({r.scene, std::string("RMS |F|, peak |F|"), std::string(), O(), O(), O(), O(), O(), O(), O(), O(), O(), std::string(), O(),
+                 O(), O(), O(), r.note});
+      continue;
+    }
+    const ReferenceVerification& v = *r.verification;
+    const std::string levels =
+        "L" + std::to_string(v.levels[0]) + ", L" + std::to_string(v.levels[1]) + ", L" + std::to_string(v.levels[2]);
+    for (const auto& [name, c, value] : {std::tuple{"RMS |F|", &v.rms, v.rms_force}, std::tuple{"peak |F|", &v.peak, v.peak_force}}) {
+      t.add_row({r.scene, std::string(name), levels, O(v.element_sizes[0]), O(v.element_sizes[1]), O(v.element_sizes[2]), O(value),
+                 O(c->grids.phi2), O(c->grids.phi3), O(c->r21), O(c->r32), c->observed_order,
+                 std::string(!c->observed_order ? "none" : c->oscillatory ? "oscillatory" : "monotonic"), c->extrapolated,
+                 O(c->approximate_relative_error), c->extrapolated_relative_error, c->gci_fine, c->unusable});
+    }
+  }
+  return t;
+}
+
+namespace {
+
+/// The finest reference of `reference` as plot_profiles draws it: its profile CSV with band_low and
+/// band_high columns, written to `csv`.
+ProfilePlotReference write_reference_series(const SceneReference& reference, const Eigen::Vector3d& direction, const std::filesystem::path& csv) {
+  std::vector<ReferenceLevel> levels;
+  for (std::size_t k = 0; k < reference.levels.size(); ++k)
+    levels.push_back({reference.levels[k], reference.element_sizes[k], read_profile_csv(reference.profiles[k])});
+  std::size_t finest = 0;
+  for (std::size_t k = 1; k < levels.size(); ++k)
+    if (levels[k].element_size < levels[finest].element_size) finest = k;
+  const ReferenceBand band = reference_band(levels, reference.verification, reference.tool, direction);
+  std::string text = std::string(profile_csv_header) + ",band_low,band_high\n";
+  std::size_t k = 0;
+  char line[512];
+  for (const ProfileRow& r : levels[finest].profile.rows) {
+    if (r.tool != reference.tool) continue;
+    std::snprintf(line, sizeof line, "%.17g,%s,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%s,%.17g,%.17g,%.17g,%.17g\n", r.t, r.tool.c_str(),
+                  r.position.x(), r.position.y(), r.position.z(), r.force.x(), r.force.y(), r.force.z(), std::string(to_string(r.mode)).c_str(),
+                  r.crack_extent, r.cost_s, band.low[k], band.high[k]);
+    text += line;
+    ++k;
+  }
+  write_atomically(csv, [&](const std::filesystem::path& tmp) {
+    std::ofstream f(tmp, std::ios::binary);
+    f << text;
+    if (!f.flush()) throw std::runtime_error(csv.string() + ": write failed");
+  });
+  std::string source;
+  if (band.from_gci) {
+    char text_source[96];
+    std::snprintf(text_source, sizeof text_source, "GCI band (p = %.2g)", *reference.verification->rms.observed_order);
+    source = text_source;
+  } else if (levels.size() > 1) {
+    source = "spread of L" + std::to_string(reference.levels.front()) + "..L" + std::to_string(reference.levels.back());
+  } else {
+    source = "one level: no band";
+  }
+  return {"reference L" + std::to_string(levels[finest].level), csv, source};
+}
+
+} // namespace
+
+void write_study_report(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out) {
+  namespace fs = std::filesystem;
+  result.table().write(out, "study");
+  if (!result.references.empty()) verification_table(result).write(out, "verification");
+  for (const fs::path& scene_file : spec.scenes) {
+    const Scene scene = read_scene(scene_file);
+    std::vector<std::pair<std::string, fs::path>> runs;
+    bool any_error = false;
+    for (const StudyRow& r : result.rows) {
+      if (r.scene != scene.name) continue;
+      any_error = any_error || r.metrics.has_value();
+      if (!r.profile.empty() && r.model.rfind("reference", 0) != 0) runs.emplace_back(r.model, r.profile);
+    }
+    const SceneReference* reference = nullptr;
+    for (const SceneReference& r : result.references)
+      if (r.scene == scene.name) reference = &r;
+    if (runs.empty() && !reference) continue;
+    const Eigen::Vector3d direction = advance_direction(scene);
+    std::optional<ProfilePlotReference> drawn;
+    if (reference) drawn = write_reference_series(*reference, direction, out / (scene.name + "_reference.csv"));
+    plot_profiles(out / (scene.name + "_profiles"), runs, axis_name(direction), drawn, holds_or_retreats(scene),
+                  scene.name + ": resisting force of the " + scene.tools.front().name);
+    if (any_error)
+      plot_pareto(out / (scene.name + "_pareto"), out / "study.csv", "RMS force error [%]", "p99 cost [µs]", "model", scene.name,
+                  reference && rms_error_floor(*reference) ? std::optional<double>(100.0 * *rms_error_floor(*reference)) : std::nullopt,
+                  scene.name + ": RMS force error against cost");
+  }
+}
+
+} // namespace kerf

@@ -1,0 +1,30 @@
+#pragma once
+// What a study writes once its runs are done (issue 23, "tables and plots an author can submit"):
+// the table (study.md/.tex/.csv), the reference's solution verification (verification.md/.csv),
+// and per scene the profile plot with the reference and its band (SCENE_profiles.png/.pdf/.csv)
+// and the speed/accuracy chart (SCENE_pareto.png/.pdf/.csv). Every figure has its data beside it.
+
+#include "experiments/study/study_runner.hpp"
+#include "experiments/study/study_spec.hpp"
+#include "experiments/study/study_table.hpp"
+
+#include <filesystem>
+
+namespace kerf {
+
+/// The solution verification of every scene's reference, one row per scene and quantity (RMS |F|,
+/// peak |F|): levels, element sizes, the finest three values, r21, r32, observed order p,
+/// oscillatory or not, extrapolated value, e_a, e_ext and GCI_fine (Celik et al. 2008), or a note
+/// why there is none.
+StudyTable verification_table(const StudyResult& result);
+
+/// The reference uncertainty of a scene on the study table's RMS force error scale [–]: the
+/// uncertainty of RMS |F| [N] over the finest level's peak |F| [N]; empty without a usable GCI.
+std::optional<double> rms_error_floor(const SceneReference& reference);
+
+/// Writes the tables and the plots of `result` into `out` (study.*, verification.*, and per scene of
+/// `spec` SCENE_reference.csv, SCENE_profiles.*, SCENE_pareto.*). Throws std::runtime_error if a
+/// plot cannot be drawn.
+void write_study_report(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out);
+
+} // namespace kerf
