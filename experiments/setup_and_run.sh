@@ -18,7 +18,7 @@ packages=(cmake g++ make pkg-config git
           libeigen3-dev libgmsh-dev libvtk9-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
           libssl-dev libgtest-dev libbenchmark-dev python3-matplotlib
           libdeal.ii-dev libopenblas0-pthread openmpi-bin clang-14 libclang-rt-14-dev libsuitesparse-dev
-          xvfb xauth libgl1-mesa-dri ccache)
+          xvfb xauth libgl1-mesa-dri ccache lld)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
