@@ -18,7 +18,7 @@ packages=(cmake g++ make pkg-config git
           libeigen3-dev libgmsh-dev libvtk9-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev
           libssl-dev libgtest-dev libbenchmark-dev python3-matplotlib
           libdeal.ii-dev libopenblas0-pthread openmpi-bin clang-14 libclang-rt-14-dev libsuitesparse-dev
-          xvfb xauth libgl1-mesa-dri)
+          xvfb xauth libgl1-mesa-dri ccache lld)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -39,8 +39,12 @@ if [ "$job" = asan ] || [ "$job" = asan-ci ]; then # docs/reliability.md: flags,
   # the benchmarks are no tests: CI's stage does not build them
   if [ "$job" = asan-ci ]; then options=(-DKERF_BENCHMARKS=OFF); fi
 fi
+# The default job needs the kerf executable only (and what it links): a newcomer sees results
+# without first compiling the tests and benchmarks; the test jobs build everything.
+targets=()
+if [ "$job" = default ]; then targets=(--target kerf); fi
 cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=$build_type "${options[@]}"
-cmake --build "$build" -j2
+cmake --build "$build" -j2 "${targets[@]}"
 
 case "$job" in
   default)

@@ -9,6 +9,7 @@
 #include "experiments/scene/scene_reader.hpp"
 #include "meshes/atomic_file.hpp"
 #include "realtime/haptics/device_emulator.hpp"
+#include "realtime/haptics/device_specs.hpp"
 
 #include <atomic>
 #include <csignal>
@@ -26,7 +27,8 @@ struct DeviceSimOptions {
   std::vector<int> ports;
   std::string host = "127.0.0.1";
   double rate = 1000.0;
-  double max_force = 8.5;
+  std::string device_model{default_device_model};
+  double max_force = 0.0; ///< [N] 0: the device model's maximum force
   HandParameters hand;
   double hold = 0.5;
   double tail = 0.5;
@@ -60,6 +62,7 @@ void run_device_sim(const DeviceSimOptions& o) {
     throw std::invalid_argument("device-sim: scene " + scene.name + " has " + std::to_string(scene.tools.size()) +
                                 " tool(s); give one --port per tool (got " + std::to_string(ports.size()) + ")");
   const std::vector<SampledTrajectory> targets = sample_scene_trajectories(scene);
+  const double max_force = o.max_force > 0.0 ? o.max_force : device_specs(o.device_model).max_force;
 
   std::vector<std::unique_ptr<DeviceEmulator>> emulators;
   std::vector<std::string> tools;
@@ -68,7 +71,7 @@ void run_device_sim(const DeviceSimOptions& o) {
     s.host = o.host;
     s.port = ports[i];
     s.rate = o.rate;
-    s.max_force = o.max_force;
+    s.max_force = max_force;
     s.hand = o.hand;
     s.hold = o.hold;
     s.tail = o.tail;
@@ -79,7 +82,7 @@ void run_device_sim(const DeviceSimOptions& o) {
     tools.push_back(scene.tools[i].name);
     std::printf("device %s: udp://%s:%d, %.0f Hz, max %.2f N, hand m = %.3f kg, k = %.0f N/m, zeta = %.2f; "
                 "trajectory %.3f s\n",
-                tools[i].c_str(), o.host.c_str(), emulators.back()->port(), o.rate, o.max_force, o.hand.mass,
+                tools[i].c_str(), o.host.c_str(), emulators.back()->port(), o.rate, max_force, o.hand.mass,
                 o.hand.stiffness, o.hand.damping_ratio, targets[i].duration());
   }
   std::fflush(stdout);
@@ -117,8 +120,10 @@ void add_device_sim_command(CLI::App& app) {
   c->add_option("--port", o->ports, "UDP port per tool, in scene order (default 47000, 47001)");
   c->add_option("--host", o->host, "numeric IPv4 address to listen on")->capture_default_str();
   c->add_option("--rate", o->rate, "device rate [Hz]")->capture_default_str();
-  c->add_option("--max-force", o->max_force, "declared maximum force [N] (PHANToM Premium 1.5: 8.5 N)")
+  c->add_option("--device-model", o->device_model,
+                "the emulated device, for the maximum force it declares: " + device_model_names())
       ->capture_default_str();
+  c->add_option("--max-force", o->max_force, "declared maximum force [N] (default: the device model's)");
   c->add_option("--hand-mass", o->hand.mass, "hand + handle mass [kg]")->capture_default_str();
   c->add_option("--hand-stiffness", o->hand.stiffness, "arm stiffness toward the target [N/m]")->capture_default_str();
   c->add_option("--hand-damping-ratio", o->hand.damping_ratio, "arm damping ratio")->capture_default_str();

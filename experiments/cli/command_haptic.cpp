@@ -7,6 +7,7 @@
 #include "experiments/run/model_catalogue.hpp"
 #include "experiments/run/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "realtime/haptics/device_specs.hpp"
 #include "realtime/haptics/servo_loop.hpp"
 #include "realtime/haptics/udp_device.hpp"
 
@@ -27,10 +28,13 @@ struct HapticOptions {
   double model_rate = 0.0;
   std::string record;
   double duration = 0.0;
-  double max_force = 8.5;
-  double force_rate = 1000.0;
-  double ramp = 0.2;
-  double watchdog = 0.05;
+  std::string device_model{default_device_model};
+  double max_force = default_safety_limits.max_force;
+  double force_rate = default_safety_limits.max_force_rate;
+  double ramp = default_safety_limits.ramp_time;
+  double watchdog = default_safety_limits.watchdog_timeout;
+  bool max_force_given = false; ///< --max-force on the command line (else the device model's)
+  bool watchdog_given = false;  ///< --watchdog on the command line (else default_watchdog_timeout(rate))
   VirtualCoupling coupling;
   bool no_realtime = false;
 };
@@ -49,6 +53,27 @@ void print_histogram(const char* name, const DurationHistogram& h) {
 }
 
 void run_haptic(const HapticOptions& o) {
+  // The safety limits: the named device's maximum force unless --max-force asks for less (never
+  // more), the watchdog at least two servo periods unless given.
+  const DeviceSpecs& specs = device_specs(o.device_model);
+  if (o.max_force_given && o.max_force > specs.max_force) {
+    char message[256];
+    std::snprintf(message, sizeof message, "haptic: --max-force %g N exceeds the %s's maximum force %g N (--device-model %s)",
+                  o.max_force, std::string(specs.model).c_str(), specs.max_force, std::string(specs.name).c_str());
+    throw std::invalid_argument(message);
+  }
+  SafetyLimits safety = default_safety_limits_for(specs);
+  if (o.max_force_given) safety.max_force = o.max_force;
+  safety.max_force_rate = o.force_rate;
+  safety.ramp_time = o.ramp;
+  safety.watchdog_timeout = o.watchdog_given ? o.watchdog : default_watchdog_timeout(o.rate);
+  if (o.coupling.stiffness > specs.max_stiffness)
+    std::fprintf(stderr, "kerf haptic: warning: coupling stiffness %.0f N/m is above the %s's stable %.0f N/m\n",
+                 o.coupling.stiffness, std::string(specs.model).c_str(), specs.max_stiffness);
+  std::printf("safety: %s, clamp %.3g N, force rate %.4g N/s, ramp %.3g s, watchdog %.3g ms\n",
+              std::string(specs.model).c_str(), safety.max_force, safety.max_force_rate, safety.ramp_time,
+              safety.watchdog_timeout * 1e3);
+
   const Scene scene = read_scene(resolve_scene(o.scene));
   require_model_for_scene(o.model, scene);
   if (o.devices.size() != scene.tools.size())
@@ -72,7 +97,7 @@ void run_haptic(const HapticOptions& o) {
   settings.rate = o.rate;
   settings.model_rate = o.model_rate;
   settings.duration = o.duration;
-  settings.safety = {o.max_force, o.force_rate, o.ramp, o.watchdog};
+  settings.safety = safety;
   settings.coupling = o.coupling;
   settings.realtime = !o.no_realtime;
   settings.on_realtime = [&o](const RealtimeSetup& r) {
@@ -150,11 +175,17 @@ void add_haptic_command(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--record", o->record, "session file to record every tick to (append-only CSV)");
   c->add_option("--duration", o->duration, "seconds until the ramp out begins; 0 = until Ctrl-C")->capture_default_str();
-  c->add_option("--max-force", o->max_force, "force clamp [N] (the device's declared maximum applies too)")
+  c->add_option("--device-model", o->device_model,
+                "the device, for its maximum force and stable stiffness: " + device_model_names())
+      ->capture_default_str();
+  c->add_option("--max-force", o->max_force,
+                "force clamp [N], at most the device model's (default: its maximum; the device's declared maximum "
+                "applies too)")
       ->capture_default_str();
   c->add_option("--force-rate", o->force_rate, "force-rate limit [N/s]")->capture_default_str();
   c->add_option("--ramp", o->ramp, "ramp in/out time [s]")->capture_default_str();
-  c->add_option("--watchdog", o->watchdog, "zero force after this much link silence [s]")->capture_default_str();
+  c->add_option("--watchdog", o->watchdog,
+                "zero force once the newest device state is this old [s] (default 10 ms, at least two servo periods)");
   c->add_option("--coupling-stiffness", o->coupling.stiffness,
                 "render through Colgate's virtual coupling of this stiffness [N/m]; 0 = the model's force directly")
       ->capture_default_str();
@@ -162,7 +193,11 @@ void add_haptic_command(CLI::App& app) {
   c->add_option("--virtual-mass", o->coupling.virtual_mass, "virtual tool mass of the coupling [kg]")
       ->capture_default_str();
   c->add_flag("--no-realtime", o->no_realtime, "do not ask for SCHED_FIFO and locked memory");
-  c->callback([o] { run_haptic(*o); });
+  c->callback([o, c] {
+    o->max_force_given = c->count("--max-force") > 0;
+    o->watchdog_given = c->count("--watchdog") > 0;
+    run_haptic(*o);
+  });
 }
 
 } // namespace kerf::cli

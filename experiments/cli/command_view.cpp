@@ -34,10 +34,10 @@ struct ViewOptions {
   double rate = 1000.0;
   double model_rate = 0.0;
   double duration = -1.0;
-  double max_force = 8.5;
-  double force_rate = 1000.0;
-  double ramp = 0.2;
-  double watchdog = 0.05;
+  double max_force = default_safety_limits.max_force;
+  double force_rate = default_safety_limits.max_force_rate;
+  double ramp = default_safety_limits.ramp_time;
+  double watchdog = -1.0; ///< [s] < 0: default_watchdog_timeout(rate)
   bool no_realtime = false;
   std::string screenshot;
   double at = -1.0;
@@ -177,7 +177,7 @@ void scene_live(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, B
   s.servo.rate = o.rate;
   s.servo.model_rate = o.model_rate;
   s.servo.duration = duration;
-  s.servo.safety = {o.max_force, o.force_rate, o.ramp, o.watchdog};
+  s.servo.safety = {o.max_force, o.force_rate, o.ramp, o.watchdog < 0.0 ? default_watchdog_timeout(o.rate) : o.watchdog};
   s.servo.realtime = !o.no_realtime;
   s.servo.on_realtime = [&o](const RealtimeSetup& r) {
     if (o.no_realtime) std::fprintf(stderr, "kerf view: real-time scheduling not requested (--no-realtime)\n");
@@ -304,7 +304,8 @@ void add_view_command(CLI::App& app) {
   c->add_option("--max-force", o->max_force, "force clamp [N]")->capture_default_str();
   c->add_option("--force-rate", o->force_rate, "force-rate limit [N/s]")->capture_default_str();
   c->add_option("--ramp", o->ramp, "ramp in/out time [s]")->capture_default_str();
-  c->add_option("--watchdog", o->watchdog, "zero force after this much link silence [s]")->capture_default_str();
+  c->add_option("--watchdog", o->watchdog,
+                "zero force once the newest device state is this old [s] (default 10 ms, at least two servo periods)");
   c->add_flag("--no-realtime", o->no_realtime, "do not ask for SCHED_FIFO and locked memory");
   c->add_option("--screenshot", o->screenshot,
                 "write a PNG off screen: a scene is stepped off line to --at (no servo loop); runs are shown at --at");

@@ -74,7 +74,7 @@ const char* fracture_name(ReferenceFracture f) {
 
 } // namespace
 
-ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSettings& settings) {
+ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSettings& settings, int solver_version) {
   // The scene: its file, the geometry file it meshes, and what a caller may have changed in
   // memory since reading it (materials, mesh size, the trajectory).
   const std::string scene_sha = file_sha256(scene.file);
@@ -108,6 +108,7 @@ ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSett
 
   // The solver: what the settings choose, and the defaults run_reference keeps.
   const reference::SolverSettings defaults;
+  text += "solver_version = " + std::to_string(solver_version) + "\n";
   text += "degree = " + std::to_string(settings.degree) + "\n";
   text += "refinements = " + std::to_string(settings.refinements) + "\n";
   text += "linear_solver = " + std::string(solver_name(settings.linear_solver)) + "\n";

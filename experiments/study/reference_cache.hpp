@@ -7,12 +7,14 @@
 // contact penalty, load-path cut-backs, cohesive fracture on/off, the number of MPI processes the
 // mesh is distributed over). Any change of one of them misses the cache; nothing else does.
 //
-// Not in the key: the reference's source code. A change of the solver's code that changes its
-// numbers without changing a setting needs the cache deleted (docs/studies.md).
+// The reference's code enters through its version (reference/solver_version.hpp), a number the
+// reference bumps whenever its numbers change: a profile cached by another version has another
+// key, so it is recomputed, never read.
 
 #include "experiments/run/reference_run.hpp"
 #include "experiments/scene/scene.hpp"
 #include "experiments/study/study_spec.hpp"
+#include "reference/solver_version.hpp"
 
 #include <cstddef>
 #include <string>
@@ -51,7 +53,9 @@ struct ReferenceCacheKey {
 /// `kerf calibrate`'s). The solver's own defaults that `run_reference` does not take from
 /// `settings` (reference::SolverSettings tolerances, DOF limit, penalty; LoadPathSettings
 /// cut-backs) enter with their current values, so a changed default also misses the cache.
+/// `solver_version` is the reference's (reference::solver_version); a test may key another.
 /// Throws std::runtime_error if the scene or geometry file cannot be read.
-ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSettings& settings);
+ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSettings& settings,
+                                      int solver_version = reference::solver_version);
 
 } // namespace kerf

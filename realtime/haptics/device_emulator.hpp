@@ -6,6 +6,7 @@
 // records every force command it accepted.
 
 #include "realtime/haptics/device_protocol.hpp"
+#include "realtime/haptics/device_specs.hpp"
 #include "realtime/haptics/simulated_hand.hpp"
 
 #include <Eigen/Core>
@@ -21,9 +22,9 @@ struct EmulatedDeviceSettings {
   std::string host = "127.0.0.1";  ///< address to bind (loopback by default)
   int port = 0;                    ///< UDP port; 0 picks a free one (see DeviceEmulator::port())
   double rate = 1000.0;            ///< state packets per second and hand integration rate [Hz]
-  /// Declared maximum force [N]. Default 8.5 N: the peak force of a PHANToM Premium 1.5
-  /// (3D Systems / SensAble data sheet), a common research device.
-  double max_force = 8.5;
+  /// Declared maximum force [N]. Default: the default device's (device_table, 8.5 N for the
+  /// PHANToM Premium 1.5, a common research device).
+  double max_force = device_specs_constexpr(default_device_model).max_force;
   HandParameters hand;
   std::vector<Eigen::Vector3d> target;  ///< target positions [m] sampled at target_rate
   double target_rate = 1000.0;          ///< [Hz]

@@ -56,7 +56,11 @@ Eigen::Vector3d SafetyLayer::filter(const Eigen::Vector3d& desired, double now, 
     m_previous.setZero();
     return m_previous;
   }
-  if (!(link_age <= m_limits.watchdog_timeout)) { // also a NaN age
+  // A state watchdog_timeout old or older is silence (a NaN age too). The servo loop's clock is
+  // its deadlines in whole nanoseconds, so n periods of age are n T up to the rounding of a
+  // difference of two doubles: the 1 ns of slack makes the n-th tick trip whatever that rounding.
+  constexpr double clock_slack = 1e-9; // [s]
+  if (!(link_age < m_limits.watchdog_timeout - clock_slack)) {
     ++m_counters.watchdog;
     status |= safety_watchdog;
     m_previous.setZero();

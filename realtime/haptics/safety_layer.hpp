@@ -1,7 +1,7 @@
 #pragma once
 // The safety layer between a model and a device (../shared/DESIGN.md, "Realtime contract"): it
 // holds whatever the model does. Per tick, in this order:
-//   1. emergency stop latched, or the link silent for longer than the watchdog time -> F = 0 now;
+//   1. emergency stop latched, or the link silent for the watchdog time or longer -> F = 0 now;
 //   2. NaN/Inf guard: a non-finite model force is replaced by zero;
 //   3. ramp: F_target = g(t) F_model, g rising linearly 0 -> 1 over the ramp time after start()
 //      and falling linearly to 0 over the ramp time after stop();
@@ -12,6 +12,7 @@
 // Zeroing in step 1 is immediate (not rate limited): removing force is the safe direction.
 
 #include "realtime/haptics/device_protocol.hpp"
+#include "realtime/haptics/device_specs.hpp"
 
 #include <Eigen/Core>
 
@@ -24,8 +25,30 @@ struct SafetyLimits {
   double max_force = 0.0;        ///< [N] configured maximum; the device's declared one also applies
   double max_force_rate = 0.0;   ///< [N/s] largest change of the commanded force per second
   double ramp_time = 0.0;        ///< [s] duration of the linear ramp in and out
-  double watchdog_timeout = 0.0; ///< [s] longest silence of the device link before force is zeroed
+  double watchdog_timeout = 0.0; ///< [s] a device state this old or older is silence: force is zeroed
 };
+
+/// The rig's safety defaults, defined here once (`kerf haptic`, `kerf view --device`, the tests):
+///   - max_force 8.5 N: the default device's maximum force (default_device_model, device_table);
+///   - max_force_rate 1000 N/s: the full 8.5 N in 8.5 ms, no step a hand feels as a blow;
+///   - ramp_time 0.2 s: force fades in and out over 200 servo ticks at 1 kHz;
+///   - watchdog_timeout 10 ms: at 1 kHz, zero force on the 10th tick without a new device state.
+inline constexpr SafetyLimits default_safety_limits{device_specs_constexpr(default_device_model).max_force, 1000.0,
+                                                    0.2, 0.010};
+
+/// The default watchdog time at servo rate `rate` [Hz]: default_safety_limits' 10 ms, but never
+/// below two servo periods (a device sending at the servo rate leaves one period between states,
+/// and a single late state must not zero the force). ServoLoop rejects a shorter one.
+[[nodiscard]] constexpr double default_watchdog_timeout(double rate) noexcept {
+  return default_safety_limits.watchdog_timeout > 2.0 / rate ? default_safety_limits.watchdog_timeout : 2.0 / rate;
+}
+
+/// The default limits for the device `specs` (its maximum force; the rest as default_safety_limits).
+[[nodiscard]] constexpr SafetyLimits default_safety_limits_for(const DeviceSpecs& specs) noexcept {
+  SafetyLimits limits = default_safety_limits;
+  limits.max_force = specs.max_force;
+  return limits;
+}
 
 /// Counts of what the layer did over a session (ticks).
 struct SafetyCounters {

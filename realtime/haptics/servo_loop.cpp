@@ -29,8 +29,10 @@ void sleep_until_ns(std::int64_t deadline) noexcept {
   }
 }
 
-/// Sleeps to absolute deadlines start + k T and keeps `stats`. `work(now_s, late_s)` returns
-/// false to end the loop; `stop` ends it too. A tick whose work ends after the next deadline is
+/// Sleeps to absolute deadlines start + k T and keeps `stats`. `work(now_s, late_s)` is called
+/// with the deadline's time since the start (the loop's own clock: whole periods, so an interval
+/// of n ticks is n T whatever the wake-up jitter) and how late it woke; it returns false to end
+/// the loop; `stop` ends it too. A tick whose work ends after the next deadline is
 /// an overrun; the deadlines it covered are skipped (counted as missed), not caught up.
 template <typename Work>
 void run_periodic(double rate, TimingStatistics& stats, const std::atomic<bool>* stop, Work&& work) noexcept {
@@ -45,7 +47,7 @@ void run_periodic(double rate, TimingStatistics& stats, const std::atomic<bool>*
     stats.lateness.add(1e-9 * static_cast<double>(wake - deadline));
     if (stats.ticks > 0) stats.period_jitter.add(1e-9 * std::abs(static_cast<double>(wake - previous_wake - period)));
     previous_wake = wake;
-    const bool go = work(1e-9 * static_cast<double>(wake - start), 1e-9 * static_cast<double>(wake - deadline));
+    const bool go = work(1e-9 * static_cast<double>(deadline - start), 1e-9 * static_cast<double>(wake - deadline));
     const std::int64_t end = now_ns();
     stats.tick.add(1e-9 * static_cast<double>(end - wake));
     ++stats.ticks;
@@ -88,6 +90,11 @@ ServoLoop::ServoLoop(ToolModel& model, std::span<HapticDevice* const> devices, c
                              !std::isfinite(c.virtual_mass))))
     throw std::invalid_argument("servo loop: virtual coupling needs stiffness >= 0, and when > 0 damping >= 0 and a "
                                 "positive virtual mass");
+  // A watchdog shorter than two periods zeroes the force whenever one state arrives a tick late.
+  if (!(settings.safety.watchdog_timeout >= 2.0 / settings.rate))
+    throw std::invalid_argument("servo loop: watchdog time must be at least two servo periods (" +
+                                std::to_string(2.0 / settings.rate) + " s at " + std::to_string(settings.rate) +
+                                " Hz; got " + std::to_string(settings.safety.watchdog_timeout) + " s)");
   m_period = 1.0 / settings.rate;
   for (std::size_t i = 0; i < m_count; ++i) m_safety.emplace_back(settings.safety);
   m_tools.resize(m_count);

@@ -82,8 +82,8 @@ public:
   /// Zeroes every force at the next tick and ends the session. Async-signal-safe.
   void request_emergency_stop() noexcept { m_emergency_requested.store(true, std::memory_order_relaxed); }
 
-  /// One servo tick at rig time `now` [s] since the loop started, woken `late` [s] after its
-  /// deadline. Allocation-free. Returns false once the session has ended. (run() calls this;
+  /// One servo tick at rig time `now` [s]: its deadline, since the loop started (run() passes
+  /// k T for tick k, plus the periods of any skipped deadlines), woken `late` [s] after it. Allocation-free. Returns false once the session has ended. (run() calls this;
   /// tests may call it directly, in single-rate mode.)
   bool tick(double now, double late) noexcept;
 

@@ -98,7 +98,8 @@ void LossyLink::run() {
              sizeof device);
       ForceCommandPacket command;
       if (decode({buffer.data(), static_cast<std::size_t>(n)}, command) == DecodeError::none)
-        m_log.commands.push_back({now, command.force, command.status});
+        m_log.commands.push_back({now, command.force, command.status, command.sequence, command.timestamp_ns,
+                                  command.echo_sequence});
     }
 
     // Device -> rig: states, damaged as configured.
@@ -108,8 +109,16 @@ void LossyLink::run() {
       ++m_log.states;
       Datagram d(buffer.begin(), buffer.begin() + n);
       DeviceStatePacket state;
-      const std::uint32_t sequence = decode(d, state) == DecodeError::none ? state.sequence : 0;
+      const bool whole = decode(d, state) == DecodeError::none;
+      const std::uint32_t sequence = whole ? state.sequence : 0;
       if (first_state < 0.0) first_state = now;
+      const std::uint64_t sent_at = state.timestamp_ns;
+      if (whole && m_faults.clock_jump_after >= 0.0 && now - first_state >= m_faults.clock_jump_after) {
+        // The device's clock has jumped: the same state, stamped clock_jump_ns later (or earlier).
+        if (m_log.first_jumped == 0) m_log.first_jumped = sequence;
+        state.timestamp_ns = static_cast<std::uint64_t>(static_cast<std::int64_t>(state.timestamp_ns) + m_faults.clock_jump_ns);
+        encode(state, std::span<std::byte, device_state_packet_size>(d.data(), device_state_packet_size));
+      }
       if (m_faults.silent_after >= 0.0 && now - first_state >= m_faults.silent_after) {
         if (m_log.silenced_at < 0.0) m_log.silenced_at = now;
         continue;
@@ -126,6 +135,7 @@ void LossyLink::run() {
         m_log.first_delivered = sequence;
         any_passed = true;
       }
+      if (d.size() == device_state_packet_size && whole) m_log.delivered_states.push_back({sequence, sent_at});
       if (m_faults.stall_period > 0.0) {
         held.push_back(std::move(d));
         continue;

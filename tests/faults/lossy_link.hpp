@@ -27,6 +27,10 @@ struct LinkFaults {
   double truncate = 0.0;      ///< cut to a length drawn uniformly in [0, 87] bytes
   double stall_period = 0.0;  ///< > 0: every state is held and all are released together once per period
   double silent_after = -1.0; ///< >= 0: from this long after the first state on, nothing reaches the rig
+  /// >= 0: from this long after the first state on, the device's clock has jumped: clock_jump_ns
+  /// is added to every later state's timestamp (negative: backwards), the rest of it untouched.
+  double clock_jump_after = -1.0;
+  std::int64_t clock_jump_ns = 0;
   unsigned seed = 1;
 };
 
@@ -35,6 +39,15 @@ struct RelayedCommand {
   double time = 0.0;                                ///< [s] since the link started
   Eigen::Vector3d force = Eigen::Vector3d::Zero();  ///< [N]
   std::uint32_t status = 0;                         ///< SafetyStatus bits
+  std::uint32_t sequence = 0;                       ///< the rig's command sequence number
+  std::uint64_t timestamp_ns = 0;                   ///< the rig's monotonic clock when sent
+  std::uint32_t echo_sequence = 0;                  ///< the newest device state the rig had accepted
+};
+
+/// One device state sent on to the rig, as the device sent it (before any clock jump).
+struct DeliveredState {
+  std::uint32_t sequence = 0;
+  std::uint64_t timestamp_ns = 0; ///< the device's monotonic clock when sent
 };
 
 /// What the link did (read after stop()).
@@ -48,6 +61,8 @@ struct LinkLog {
   std::vector<std::uint32_t> dropped;   ///< sequence numbers dropped (not silenced)
   std::uint32_t first_delivered = 0;    ///< sequence of the first state the rig was sent
   double silenced_at = -1.0;            ///< [s] when the link went silent (< 0: never)
+  std::uint32_t first_jumped = 0;       ///< sequence of the first state with a jumped clock (0: none)
+  std::vector<DeliveredState> delivered_states; ///< every whole state passed on toward the rig, in order
   std::vector<RelayedCommand> commands; ///< every force command forwarded to the device
 };
 

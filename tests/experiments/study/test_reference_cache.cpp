@@ -1,5 +1,5 @@
 // The reference cache key (experiments/study/reference_cache.hpp): every input that changes the
-// reference's numbers changes the key, and nothing else does.
+// reference's numbers changes the key, and nothing else does; the solver's version among them.
 
 #include "experiments/study/reference_cache.hpp"
 
@@ -9,8 +9,11 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <functional>
 #include <set>
+
+#include <unistd.h>
 
 using namespace kerf;
 namespace fs = std::filesystem;
@@ -134,4 +137,72 @@ TEST(ReferenceCache, TheKeyNamesTheSolverSettings) {
                            "newton_relative_tolerance = ", "iterative_tolerance = ", "contact_penalty = automatic\n",
                            "max_cutbacks = ", "max_newton_iterations = ", "trajectory_sha256 = "})
     EXPECT_NE(text.find(line), std::string::npos) << line << " not in\n" << text;
+}
+
+TEST(ReferenceCache, TheSolversVersionIsInTheKey) {
+  // reference/solver_version.hpp: a profile cached by another version of the reference's numbers
+  // has another key.
+  const Scene scene = clay_pull();
+  StudyReferenceSpec spec;
+  spec.samples = 6;
+  const ReferenceRunSettings settings = settings_of(scene, spec, 0);
+  const ReferenceCacheKey current = reference_cache_key(scene, settings);
+  EXPECT_NE(current.text.find("solver_version = " + std::to_string(reference::solver_version) + "\n"), std::string::npos)
+      << current.text;
+  EXPECT_EQ(reference_cache_key(scene, settings, reference::solver_version).directory, current.directory);
+  for (int other : {reference::solver_version - 1, reference::solver_version + 1})
+    EXPECT_NE(reference_cache_key(scene, settings, other).directory, current.directory) << "version " << other;
+}
+
+TEST(ReferenceCache, AProfileCachedByAnotherSolverVersionIsRecomputedNeverRead) {
+  // A study whose cache holds, for its one reference solve, a profile written under the previous
+  // solver version (a marker force of 123 N that no solve produces): the study solves anew (the
+  // runner is called) and scores against the new profile; a second run reads the new entry.
+  const fs::path dir = fs::temp_directory_path() / ("kerf_test_cache_version_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path study_file = dir / "v.toml";
+  std::ofstream(study_file) << "[study]\nname = \"v\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n"
+                               "[reference]\ndegree = 1\nrefinements = [0]\nsamples = 3\n";
+  const StudySpec spec = read_study(study_file);
+  const fs::path out = dir / "out";
+  const Scene scene = clay_pull();
+  const ReferenceRunSettings settings = settings_of(scene, spec.reference, 0);
+
+  // The old version's entry, where the study would find it if the key left the version out.
+  ForceProfile stale;
+  const std::vector<SampledTrajectory> trajectories = sample_scene_trajectories(scene);
+  for (std::size_t k : settings.sample_indices)
+    for (std::size_t t = 0; t < trajectories.size(); ++t) {
+      ProfileRow r;
+      r.tool = scene.tools[t].name;
+      r.t = trajectories[t].samples[k].time;
+      r.position = trajectories[t].samples[k].position;
+      r.force = Eigen::Vector3d(0.0, 0.0, 123.0);
+      stale.rows.push_back(r);
+    }
+  const ReferenceCacheKey old_key =
+      reference_cache_key(study_reference_scene(scene, 0), settings, reference::solver_version - 1);
+  write_profile_csv(stale, out / "cache" / old_key.directory / "profile.csv");
+
+  int solves = 0;
+  const ReferenceRunner fresh = [&](const Scene&, const StudyReferenceSpec&, int, const std::vector<std::size_t>&,
+                                    const fs::path&) {
+    ++solves;
+    ForceProfile p = stale;
+    for (ProfileRow& r : p.rows) r.force = Eigen::Vector3d(0.0, 0.0, 1.0);
+    return p;
+  };
+  const StudyResult first = run_study(spec, out, fresh);
+  EXPECT_EQ(solves, 1) << "the profile of another solver version was read back";
+  EXPECT_EQ(first.reference_runs, 1);
+  const ReferenceCacheKey new_key = reference_cache_key(study_reference_scene(scene, 0), settings);
+  ASSERT_TRUE(fs::exists(out / "cache" / new_key.directory / "profile.csv"));
+  for (const ProfileRow& r : read_profile_csv(out / "cache" / new_key.directory / "profile.csv").rows)
+    EXPECT_EQ(r.force.z(), 1.0);
+  // The current version's entry is read (the test can tell a read from a solve).
+  const StudyResult second = run_study(spec, out, fresh);
+  EXPECT_EQ(solves, 1);
+  EXPECT_EQ(second.reference_runs, 0);
+  fs::remove_all(dir);
 }

@@ -2,9 +2,10 @@
 # The live rig from the command line, as an experimenter runs it, over loopback:
 #  1. kerf device-sim + kerf haptic --record: the session's model forces equal an offline
 #     `kerf run --trajectory SESSION` of the same scene (to 1e-9 N, the model is deterministic);
-#  2. device-sim killed with SIGKILL mid-session: every tick whose link is older than the 50 ms
+#  2. device-sim killed with SIGKILL mid-session: every tick whose link is as old as the 10 ms
 #     watchdog commands exactly zero, and there are such ticks;
-#  3. SIGTERM to kerf haptic is an emergency stop: it exits 0 and says so.
+#  3. SIGTERM to kerf haptic is an emergency stop: it exits 0 and says so;
+#  4. --device-model: an unknown name, or --max-force above the named device's maximum, is refused.
 # Ports are picked by the kernel (--port 0) and read from device-sim's output, so parallel runs
 # do not collide. Usage: cli_session.sh KERF SCENE WORKDIR
 set -euo pipefail
@@ -59,7 +60,7 @@ kill -KILL $SIM
 wait $SIM || true
 wait $RIG
 # column 25 = link_age_s, 18-20 = commanded force
-tail -n +4 killed.csv | awk -F, '$25 > 0.05 { silent++; if ($18 != 0 || $19 != 0 || $20 != 0) { print "nonzero force at link age " $25 ": " $0; bad = 1 } }
+tail -n +4 killed.csv | awk -F, '$25 >= 0.01 - 1e-9 { silent++; if ($18 != 0 || $19 != 0 || $20 != 0) { print "nonzero force at link age " $25 ": " $0; bad = 1 } }
   END { if (silent < 100) { print "only " silent " silent ticks"; bad = 1 } exit bad }'
 echo "2. killed device: zero force once the link is older than the watchdog time"
 
@@ -75,3 +76,12 @@ grep -q "emergency stop" haptic3.log || { cat haptic3.log; echo "no emergency st
 kill -INT $SIM 2>/dev/null || true
 wait $SIM || true
 echo "3. SIGTERM: emergency stop, exit 0"
+
+# 4. a named device gives its limits; an unknown one, or a clamp above the device's, is an error
+"$KERF" haptic "$SCENE" --model fracture --device udp://127.0.0.1:9 --device-model phantom > model1.log 2>&1 &&
+  { echo "an unknown --device-model was accepted"; exit 1; }
+grep -q "unknown device model 'phantom'.*touch" model1.log || { cat model1.log; echo "no error naming the model"; exit 1; }
+"$KERF" haptic "$SCENE" --model fracture --device udp://127.0.0.1:9 --device-model touch --max-force 5 > model2.log 2>&1 &&
+  { echo "--max-force above the Touch's 3.3 N was accepted"; exit 1; }
+grep -q "exceeds the 3D Systems Touch's maximum force 3.3" model2.log || { cat model2.log; echo "no error naming the limit"; exit 1; }
+echo "4. --device-model: unknown names and clamps above the device's maximum are refused"

@@ -114,10 +114,11 @@ TEST(SafetyLayer, WatchdogAndEmergencyStopZeroAtOnce) {
   s.start(-10.0);
   std::uint32_t status = 0;
   const double dt = 1.0 / 128.0;
-  for (int k = 0; k < 4; ++k) s.filter({3.5, 0.0, 0.0}, 0.0, 0.0625, dt, 8.5, status); // age == timeout: alive
+  // A state one microsecond younger than the timeout: alive.
+  for (int k = 0; k < 4; ++k) s.filter({3.5, 0.0, 0.0}, 0.0, 0.0625 - 1e-6, dt, 8.5, status);
   EXPECT_EQ(s.last_output().x(), 3.5);
-  // Silent for longer than the timeout: zero in one tick, although the rate limit allows 1 N.
-  EXPECT_EQ(s.filter({3.5, 0.0, 0.0}, 0.0, 0.0626, dt, 8.5, status), Eigen::Vector3d::Zero());
+  // A state as old as the timeout is silence: zero in one tick, although the rate limit allows 1 N.
+  EXPECT_EQ(s.filter({3.5, 0.0, 0.0}, 0.0, 0.0625, dt, 8.5, status), Eigen::Vector3d::Zero());
   EXPECT_TRUE(status & safety_watchdog);
   EXPECT_EQ(s.filter({3.5, 0.0, 0.0}, 0.0, std::nan(""), dt, 8.5, status), Eigen::Vector3d::Zero());
   // The link is back: force returns through the rate limit (1 N per tick), not as a jump.
