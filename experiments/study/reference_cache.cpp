@@ -2,6 +2,7 @@
 
 #include "experiments/profile/force_profile.hpp"
 #include "experiments/run/run_model.hpp"
+#include "experiments/run/scene_mesh.hpp"
 #include "reference/load_path.hpp"
 #include "reference/mpi_processes.hpp"
 
@@ -84,6 +85,11 @@ ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSett
   for (const auto& [name, value] : scene.geometry.parameters) parameters += " " + name + "=" + exact(value);
   text += "geometry_parameters =" + parameters + "\n";
   text += "element_size = " + exact(scene.geometry.element_size) + "\n";
+  // The parameters kerf derives for the reference's mesh from the scene (grasp discs, gradings):
+  // a change of the rules that derive them changes the mesh.
+  std::string derived;
+  for (const auto& [name, value] : scene_mesh_parameters(scene, MeshPurpose::reference)) derived += " " + name + "=" + exact(value);
+  text += "reference_mesh_parameters =" + derived + "\n";
   text += "material = " + material_line(scene.material) + "\n";
   for (const Material& layer : scene.layers) text += "layer = " + material_line(layer) + "\n";
 
@@ -110,6 +116,7 @@ ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSett
   const reference::SolverSettings defaults;
   text += "solver_version = " + std::to_string(solver_version) + "\n";
   text += "degree = " + std::to_string(settings.degree) + "\n";
+  text += "adaptive_sampling = " + exact(settings.adaptive_force_change) + " " + exact(settings.adaptive_min_travel) + "\n";
   text += "refinements = " + std::to_string(settings.refinements) + "\n";
   text += "linear_solver = " + std::string(solver_name(settings.linear_solver)) + "\n";
   text += "direct_dof_limit = " + std::to_string(defaults.direct_dof_limit) + "\n";

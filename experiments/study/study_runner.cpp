@@ -8,10 +8,9 @@
 #include "experiments/study/machine_label.hpp"
 #include "experiments/study/model_resolution.hpp"
 #include "experiments/study/reference_cache.hpp"
+#include "meshes/atomic_file.hpp"
 
 #include <nlohmann/json.hpp>
-
-#include "meshes/atomic_file.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -515,6 +514,17 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
         verified.note = std::string("no GCI available: ") + e.what();
       }
       verified.note = failed_levels + verified.note;
+      // The finest reference's own resolution check (the cohesive zone's elements, reference_fracture.hpp):
+      // a reference that fails it says so on its row.
+      for (std::size_t k : scenes[s].levels)
+        if (solves[k].level == finest_level && fs::exists(solves[k].dir / "manifest.json")) {
+          std::ifstream in(solves[k].dir / "manifest.json");
+          const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
+          if (!manifest.is_discarded() && manifest.contains("fracture") && manifest.at("fracture").contains("warning") &&
+              manifest.at("fracture").at("warning").is_string() && !manifest.at("fracture").at("warning").get<std::string>().empty())
+            verified.note = "fails its resolution check: " + manifest.at("fracture").at("warning").get<std::string>() + "; " +
+                            verified.note;
+        }
       char size[64];
       std::snprintf(size, sizeof size, "mesh h = %.3g mm; ", study_reference_element_size(scene, finest_level) * 1e3);
       StudyRow row{scene.name, "reference L" + std::to_string(finest_level), std::nullopt, cost_statistics(*finest), size + verified.note, {}};
