@@ -53,6 +53,7 @@ struct ReferenceOptions {
   std::string element_size; ///< overrides the scene's element size ("5 mm"); empty = the scene's
   bool resume = false;
   std::string fracture = "auto";
+  std::string mesh = "reference"; ///< "reference": the scene meshed for the reference (graded); "scene": its own mesh
   double adaptive = 0.05;      ///< adaptive sampling: the force change (fraction of the peak) that inserts a sample; 0: off
   double min_travel_mm = 0.05; ///< adaptive sampling: the least tool travel between two samples [mm]
   double viscous_time = 0.0; ///< τ [s] of the cohesive law's viscous regularisation (0: none)
@@ -78,7 +79,7 @@ struct ReferenceOptions {
   if (o.until >= 0.0) args.insert(args.end(), {"--until", std::to_string(o.until)});
   if (o.levels > 0) args.insert(args.end(), {"--levels", std::to_string(o.levels)});
   if (!o.element_size.empty()) args.insert(args.end(), {"--element-size", o.element_size});
-  args.insert(args.end(), {"--fracture", o.fracture});
+  args.insert(args.end(), {"--fracture", o.fracture, "--mesh", o.mesh});
   args.insert(args.end(), {"--adaptive", std::to_string(o.adaptive), "--min-travel", std::to_string(o.min_travel_mm)});
   if (o.viscous_time > 0.0) args.insert(args.end(), {"--cohesive-viscous-time", std::to_string(o.viscous_time)});
   if (o.dynamic) args.emplace_back("--dynamic");
@@ -159,7 +160,7 @@ void run_reference_command(const ReferenceOptions& o) {
     }
   }
   const auto begin = std::chrono::steady_clock::now();
-  const TetMesh mesh = scene_mesh(scene, MeshPurpose::reference);
+  const TetMesh mesh = scene_mesh(scene, o.mesh == "scene" ? MeshPurpose::scene : MeshPurpose::reference);
   if (o.levels > 0) {
     if (o.resume) throw std::invalid_argument("--resume does not apply to a convergence study (--levels)");
     const fs::path dir = o.out.empty() ? fs::path("runs") / read.name / "reference_convergence" : fs::path(o.out);
@@ -217,6 +218,10 @@ void add_reference_command(CLI::App& app) {
                   "cohesive fracture along the scene's cut_plane: auto (default: on for a scene that declares cutting or "
                   "tearing and gives cohesive_strength and fracture_toughness), on, off")
       ->check(CLI::IsMember({"auto", "on", "off"}));
+  cmd->add_option("--mesh", options->mesh,
+                  "reference: the scene meshed for the reference, graded where the physics needs it (default); scene: "
+                  "the scene's own mesh, as the fast models see it (docs/reference.md)")
+      ->check(CLI::IsMember({"reference", "scene"}));
   cmd->add_option("--adaptive", options->adaptive,
                   "adaptive sampling: where the force changes by more than this fraction of its peak between two "
                   "samples, or the interaction mode changes (contact, rupture, cutting), solve the sample half way "

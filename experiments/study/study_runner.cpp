@@ -308,7 +308,8 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     PlannedScene planned{read_scene(scene_file), {}};
     const Scene& scene = planned.scene;
     if (with_reference)
-      for (int level : spec.reference.refinements) planned.levels.push_back(plan_solve(scene, level, spec.reference.samples));
+      for (int level : spec.reference.levels_of(scene_file.stem().string()))
+        planned.levels.push_back(plan_solve(scene, level, spec.reference.samples));
     const std::size_t index = scenes.size();
     for (const std::string& model : spec.models) {
       PhenomenonSet represented;
@@ -350,8 +351,8 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
                    out / scene.name / (model + "-calibrated")};
         if (run.refusal.empty()) {
           try {
-            run.reference = plan_solve(calibration_scene(scene, fit.speed),
-                                       *std::max_element(spec.reference.refinements.begin(), spec.reference.refinements.end()),
+            const std::vector<int>& levels = spec.reference.levels_of(scene_file.stem().string());
+            run.reference = plan_solve(calibration_scene(scene, fit.speed), *std::max_element(levels.begin(), levels.end()),
                                        fit.samples > 0 ? fit.samples : spec.reference.samples);
           } catch (const std::invalid_argument& e) {
             run.refusal = std::string("not calibrated: ") + e.what();

@@ -81,25 +81,38 @@ StudySpec read_study(const std::filesystem::path& file) {
   }
   if (const toml::table* ref = doc["reference"].as_table()) {
     spec.has_reference = true;
-    allow_only(file, *ref, "reference.", {"degree", "refinements", "samples", "linear_solver", "fracture"});
+    allow_only(file, *ref, "reference.", {"degree", "refinements", "scene_refinements", "samples", "linear_solver", "fracture"});
     if (auto d = (*ref)["degree"]) {
       const auto v = d.value<int64_t>();
       if (!v || (*v != 1 && *v != 2)) fail(file, d.node()->source(), "reference.degree", "expected 1 or 2");
       spec.reference.degree = static_cast<int>(*v);
     }
-    if (auto r = (*ref)["refinements"]) {
+    // An array of ascending mesh levels, the last the finest.
+    auto read_levels = [&](const toml::node_view<const toml::node>& r, const std::string& key) {
       const toml::array* a = r.as_array();
       const std::string range = std::to_string(minimum_study_mesh_level) + "..4";
-      if (!a || a->empty()) fail(file, r.node()->source(), "reference.refinements", "expected an array of levels in " + range);
-      spec.reference.refinements.clear();
+      if (!a || a->empty()) fail(file, r.node()->source(), key, "expected an array of levels in " + range);
+      std::vector<int> levels;
       for (const toml::node& n : *a) {
         const auto v = n.value<int64_t>();
         if (!v || *v < minimum_study_mesh_level || *v > 4)
-          fail(file, n.source(), "reference.refinements",
-               "expected a level in " + range + " (k < 0: the scene's element size times 2^-k)");
-        if (!spec.reference.refinements.empty() && *v <= spec.reference.refinements.back())
-          fail(file, n.source(), "reference.refinements", "expected ascending levels (the last is the finest)");
-        spec.reference.refinements.push_back(static_cast<int>(*v));
+          fail(file, n.source(), key, "expected a level in " + range + " (k < 0: the scene's element size times 2^-k)");
+        if (!levels.empty() && *v <= levels.back()) fail(file, n.source(), key, "expected ascending levels (the last is the finest)");
+        levels.push_back(static_cast<int>(*v));
+      }
+      return levels;
+    };
+    if (auto r = (*ref)["refinements"]) spec.reference.refinements = read_levels(r, "reference.refinements");
+    if (auto r = (*ref)["scene_refinements"]) {
+      const toml::table* t = r.as_table();
+      if (!t) fail(file, r.node()->source(), "reference.scene_refinements", "expected a table { SCENE = [levels] }");
+      for (const auto& [name, levels] : *t) {
+        const std::string scene(name.str());
+        const bool known = std::any_of(spec.scenes.begin(), spec.scenes.end(),
+                                       [&](const std::filesystem::path& p) { return p.stem().string() == scene; });
+        if (!known) fail(file, levels.source(), "reference.scene_refinements." + scene, "expected a scene of study.scenes");
+        spec.reference.scene_refinements[scene] =
+            read_levels(toml::node_view<const toml::node>(&levels), "reference.scene_refinements." + scene);
       }
     }
     if (auto s = (*ref)["samples"]) {

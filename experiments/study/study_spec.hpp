@@ -15,6 +15,7 @@
 //   samples = 40                                   # trajectory samples the reference solves
 //   linear_solver = "auto"                         # "auto", "direct" or "iterative"
 //   fracture = "off"                               # cohesive fracture: "off", "auto" or "on"
+//   scene_refinements = { potato_rect_cut = [-3, -2, -1] }   # a scene's own levels (optional)
 //
 //   [models.springs]                               # optional: a model at several resolutions,
 //   resolutions = [4, 8, 12]                       # one row "springs [N = 4]" … each (instead of the
@@ -62,6 +63,15 @@ struct StudyReferenceSpec {
   /// times (element size h/2^k); k < 0: the scene meshed anew at 2^-k h (reference_cache.hpp,
   /// study_reference_scene), a cheap coarse level. In minimum_study_mesh_level..4.
   std::vector<int> refinements{0};
+  /// Per-scene mesh levels replacing `refinements` for the scenes named ([reference]
+  /// scene_refinements = { NAME = [levels] }): a scene whose finest level costs more than a study
+  /// can spend is verified on coarser ones, and its row says so (it may fail its resolution check).
+  std::map<std::string, std::vector<int>> scene_refinements;
+  /// The mesh levels of the scene named `scene`: its own, else `refinements`.
+  const std::vector<int>& levels_of(const std::string& scene) const {
+    const auto it = scene_refinements.find(scene);
+    return it == scene_refinements.end() ? refinements : it->second;
+  }
   int samples = 40; ///< equilibrium solves along each trajectory (evenly spaced samples)
   /// Linear solver of each Newton step (reference/finite_strain_solver.hpp): "auto" (direct below
   /// 60 000 DOFs), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
