@@ -57,6 +57,12 @@ TEST(StudySpec, ErrorsNameFileLineColumnAndKey) {
        ":6:16: reference.refinements"},
       {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\nrefinements = [0, -1]\n",
        ":6:19: reference.refinements"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
+       "scene_refinements = { clay_pull = [-1, 0] }\n",
+       ":6:35: reference.scene_refinements.clay_pull"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
+       "scene_refinements = { potato_rect_cut = [0, -1] }\n",
+       ":6:45: reference.scene_refinements.potato_rect_cut"},
   };
   int k = 0;
   for (const auto& [text, expected] : cases) {
@@ -612,6 +618,10 @@ TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
     EXPECT_NE(f.speed, 1.0); // the scene's own trajectory stays held out
   }
   EXPECT_EQ(fits, (std::set<std::pair<std::string, std::string>>{{"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}}));
+  // Solution verification: three mesh levels for every scene (Reference III), the potato's own
+  // (a scene of its own levels, [reference] scene_refinements), clay_pull's the study's.
+  EXPECT_EQ(s.reference.levels_of("clay_pull"), (std::vector<int>{-2, -1, 0}));
+  EXPECT_EQ(s.reference.levels_of("potato_rect_cut"), (std::vector<int>{-3, -2, -1}));
 }
 
 TEST(StudySpec, ReadsModelResolutions) {
