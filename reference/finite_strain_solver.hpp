@@ -133,6 +133,11 @@ struct SolverSettings {
   double edge_line_penalty = 0.0;
   /// Blade edge pass: edge point spacing [m]; 0 = automatic, h_min / 4.
   double edge_point_spacing = 0.0;
+  /// Newton's start: the last two converged states extrapolated linearly along the trajectory
+  /// (tool travel, else load factor, else time for a rate-dependent problem), u = u₁ + s (u₁ − u₀),
+  /// 0 <= s <= 2; from u₁ again if Newton fails from there. The equilibrium found is the same to
+  /// the Newton tolerance.
+  bool extrapolate_initial_guess = true;
   /// Launched by mpirun with N > 1 processes: distribute the mesh over them (true), or solve the
   /// whole problem on this process alone (false, e.g. a serial comparison inside an MPI job).
   bool distribute = true;
@@ -246,7 +251,8 @@ public:
 
   [[nodiscard]] std::size_t dof_count() const;
   [[nodiscard]] std::size_t cell_count() const;
-  /// "umfpack", "mumps" (distributed direct) or "petsc-cg-gamg": what `solve` uses.
+  /// "cholmod/umfpack" (serial direct, sparse_direct.hpp), "mumps" (distributed direct) or
+  /// "petsc-cg-gamg": what `solve` uses.
   [[nodiscard]] std::string linear_solver_name() const;
   /// The contact penalty in use [Pa/m].
   [[nodiscard]] double contact_penalty() const;
