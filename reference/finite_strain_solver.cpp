@@ -363,6 +363,7 @@ struct FiniteStrainSolver::Impl {
   /// s of the linear extrapolation u = u₁ + s (u₁ − u₀) to `load` (0: no predictor).
   [[nodiscard]] double extrapolation_factor(const LoadState& load) const;
   bool fault_fired = false; // the fault injection poisoned an assembly of the solve under way
+
   /// The fields of the displacement `u` (locally relevant values) to `file` (see write_fields).
   template <class VectorType>
   void write_fields(const VectorType& u, const std::filesystem::path& file, const LoadState& load) const;
@@ -798,12 +799,17 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
       // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
       for (unsigned i = 0; i < n; ++i) cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
       if (!with_matrix) continue;
-      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV
+      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV; 𝔸 of a hyperelastic law has the
+      // major symmetry 𝔸_iJkL = 𝔸_kLiJ, so K is symmetric: its upper triangle here, the lower one
+      // mirrored below (the Kelvin–Voigt tangent has no such symmetry: then every entry).
       for (unsigned j = 0; j < n; ++j) AgradN[j] = st.tangent.middleCols<3>(3 * comp[j]) * gradN[j];
       for (unsigned i = 0; i < n; ++i)
-        for (unsigned j = 0; j < n; ++j)
+        for (unsigned j = damped ? 0 : i; j < n; ++j)
           cell_K(i, j) += gradN[i].dot(AgradN[j].segment<3>(3 * comp[i])) * JxW;
     }
+    if (with_matrix && !damped)
+      for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = 0; j < i; ++j) cell_K(i, j) = cell_K(j, i);
 
     // Tractions and contact on boundary faces.
     for (const unsigned f : cell->face_indices()) {
@@ -1352,6 +1358,7 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
       again.assembly_seconds += report.assembly_seconds;
       again.linear_solve_seconds += report.linear_solve_seconds;
       again.linear_iterations += report.linear_iterations;
+      again.factorizations += report.factorizations;
       report = std::move(again);
     }
   } else {
@@ -1387,11 +1394,12 @@ template <class Algebra>
 EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState& load,
                                                    const typename Algebra::VectorType& start) {
   using VectorType = typename Algebra::VectorType;
+  constexpr bool serial_algebra = std::is_same_v<VectorType, dealii::Vector<double>>;
   Impl& m = *this;
   EquilibriumReport report;
-  // `assembly`, la.K, `rhs` and `constraints` hold the assembly of the current state la.u when
-  // `assembled`; the line search's full step (α = 1) is assembled with its tangent, so that when it
-  // is accepted the next iteration starts from it instead of assembling the same state again.
+  // `assembly` (with la.K, `rhs` and `constraints` when `with_tangent`) is the assembly of the
+  // current state la.u when `assembled`. A Newton step assembles its full step (α = 1) with the
+  // tangent, so that when it is accepted the next Newton step starts from it.
   Impl::Assembly<VectorType> assembly, full, trial;
   VectorType rhs, full_rhs, du;
   la.reinit(rhs);
@@ -1399,7 +1407,23 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
   la.reinit(du);
   dealii::AffineConstraints<double> constraints, full_constraints;
   double mismatch = 0.0;
-  bool assembled = false;
+  bool assembled = false, with_tangent = false;
+  // Quasi-Newton (SolverSettings::quasi_newton; serial direct solver): steps with the last
+  // factorised tangent K₀ corrected by the BFGS updates of the steps since (limited memory, the
+  // two-loop recursion with H₀ = K₀⁻¹; Matthies & Strang 1979, Nocedal 1980). A full Newton step
+  // (tangent assembled and factorised) is taken when a Dirichlet increment is pending, when no
+  // factorisation exists, and after a quasi-Newton step that reduced |R| by less than half, did
+  // not reduce it, or used up the updates.
+  // Contact and a cohesive interface change the tangent abruptly (points enter and leave the
+  // contact set, the interface softens): there the updates converge slowly, and full Newton is used.
+  // Every solve starts with a Newton step (FEBio's "reform each time step"), so that a solve
+  // depends on its start state alone (a run resumed from a checkpoint repeats it bit for bit).
+  const bool quasi_newton_allowed = serial_algebra && m.settings.quasi_newton && !m.tool && !m.cohesive_law &&
+                                    m.linear->kind() == TangentSolver::Kind::direct;
+  bool newton_next = true;
+  std::vector<VectorType> S, Y; // the steps s = Δu and residual changes y = ΔR of the updates
+  std::vector<double> rho;      // 1 / (yᵀ s)
+  constexpr std::size_t max_updates = 10;
   // Fault injection: asked once per iteration (the full step's assembly asks for the next one).
   int fault_asked = -1;
   bool fault_answer = false;
@@ -1429,7 +1453,9 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
         mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
         m.cohesive_secant = secant(it);
         m.poison_residual = fault(it);
-        m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
+        with_tangent = newton_next || mismatch > 0.0;
+        m.assemble(la, la.u, load, with_tangent, assembly, with_tangent ? &constraints : nullptr,
+                   with_tangent ? &rhs : nullptr);
         m.poison_residual = false;
         report.assembly_seconds += seconds_since(t0);
       }
@@ -1445,10 +1471,40 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
       }
       if (it >= m.settings.max_newton_iterations)
         return fail("no convergence in " + std::to_string(m.settings.max_newton_iterations) + " Newton iterations");
+      const bool newton_step = newton_next || mismatch > 0.0 || !quasi_newton_allowed;
+      if (newton_step && !with_tangent) {
+        // The state's residual came from a line search: its tangent is assembled now.
+        t0 = Clock::now();
+        m.cohesive_secant = secant(it);
+        m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
+        report.assembly_seconds += seconds_since(t0);
+      }
       t0 = Clock::now();
-      report.linear_iterations += m.linear->solve(la.K, du, rhs);
+      if (newton_step) {
+        report.linear_iterations += m.linear->solve(la.K, du, rhs);
+        constraints.distribute(du);
+        ++report.factorizations;
+        S.clear();
+        Y.clear();
+        rho.clear();
+      } else if constexpr (serial_algebra) {
+        // du = −H R over the free DOFs: the two-loop recursion around K₀⁻¹.
+        VectorType q = assembly.residual;
+        q.scale(la.free_mask);
+        q *= -1.0;
+        std::vector<double> alpha_k(S.size());
+        for (std::size_t k = S.size(); k-- > 0;) {
+          alpha_k[k] = rho[k] * (S[k] * q);
+          q.add(-alpha_k[k], Y[k]);
+        }
+        m.linear->solve_factorized(du, q);
+        du.scale(la.free_mask);
+        for (std::size_t k = 0; k < S.size(); ++k) {
+          const double beta = rho[k] * (Y[k] * du);
+          du.add(alpha_k[k] - beta, S[k]);
+        }
+      }
       report.linear_solve_seconds += seconds_since(t0);
-      constraints.distribute(du);
       ++report.newton_iterations;
       // Backtracking line search on the free residual: the first α in 1, ½, … (6 tries) that keeps
       // every element valid and reduces |R|, else the valid α with the smallest |R|. While a
@@ -1456,7 +1512,7 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
       // must grow with the imposed displacement): then the largest valid α is taken.
       const VectorType base = la.u;
       double best_alpha = 0.0, best_r = std::numeric_limits<double>::infinity();
-      bool full_valid = false;
+      bool full_valid = false, full_tangent = false;
       double full_mismatch = 0.0;
       for (double alpha = 1.0; alpha > 1.0 / 64.0; alpha *= 0.5) {
         la.u = base;
@@ -1464,13 +1520,16 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
         Impl::Assembly<VectorType>& a = alpha == 1.0 ? full : trial;
         t0 = Clock::now();
         if (alpha == 1.0) {
-          // The full step, assembled as the next iteration would (its constraints, tangent, fault).
+          // The full step, assembled as the next iteration would (its constraints, fault; the
+          // tangent when this step is a Newton step, whose successor is likely one too).
           full_mismatch = m.dirichlet_constraints(la, la.u, load, full_constraints);
           m.cohesive_secant = secant(it + 1);
           const bool poisoned = fault(it + 1);
           m.poison_residual = poisoned;
+          full_tangent = newton_step || !quasi_newton_allowed;
           try {
-            m.assemble(la, la.u, load, true, full, &full_constraints, &full_rhs);
+            m.assemble(la, la.u, load, full_tangent, full, full_tangent ? &full_constraints : nullptr,
+                       full_tangent ? &full_rhs : nullptr);
           } catch (const FiniteStrainError&) {
             m.poison_residual = false;
             report.assembly_seconds += seconds_since(t0);
@@ -1499,15 +1558,61 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
           break;
         }
       }
+      if (!newton_step && !(best_r < r)) {
+        // The quasi-Newton direction does not reduce |R|: back to the state, a Newton step next.
+        la.u = base;
+        newton_next = true;
+        assembled = true; // the residual is still the state's (its tangent is assembled above)
+        with_tangent = false;
+        continue;
+      }
       if (best_alpha == 0.0) return fail("every line-search step inverts an element");
       la.u = base;
       la.u.add(best_alpha, du);
+      if constexpr (serial_algebra) {
+        if (quasi_newton_allowed) {
+          // The BFGS update of this step, when the accepted state's residual is at hand: s = Δu,
+          // y = ΔR over the free DOFs, kept while yᵀ s > 0 (the curvature condition).
+          const Impl::Assembly<VectorType>* accepted =
+              best_alpha == 1.0 ? (full_valid ? &full : nullptr) : &trial;
+          const bool last_trial_is_best = best_alpha == 1.0 || best_r == m.free_norm(trial.residual, la.free_mask);
+          if (accepted != nullptr && last_trial_is_best) {
+            VectorType s = du;
+            s *= best_alpha;
+            s.scale(la.free_mask);
+            VectorType y = accepted->residual;
+            y -= assembly.residual;
+            y.scale(la.free_mask);
+            const double ys = y * s;
+            if (ys > 0.0) {
+              S.push_back(std::move(s));
+              Y.push_back(std::move(y));
+              rho.push_back(1.0 / ys);
+            }
+          }
+          newton_next = !(best_r <= 0.5 * r) || S.size() >= max_updates;
+        }
+      }
       if (best_alpha == 1.0 && full_valid) {
         std::swap(assembly, full);
-        rhs.swap(full_rhs);
-        std::swap(constraints, full_constraints);
+        if (full_tangent) {
+          rhs.swap(full_rhs);
+          std::swap(constraints, full_constraints);
+        } else {
+          constraints.clear(); // residual only: constraints are rebuilt if a Newton step follows
+          full_mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
+        }
         mismatch = full_mismatch;
+        with_tangent = full_tangent;
         assembled = true;
+      } else if (!newton_step || quasi_newton_allowed) {
+        // A shortened step: the last trial is the accepted state's residual when it was the best.
+        if (best_alpha < 1.0 && best_r == m.free_norm(trial.residual, la.free_mask)) {
+          std::swap(assembly, trial);
+          mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
+          with_tangent = false; // a Newton step next assembles the tangent at the loop's top
+          assembled = true;
+        }
       }
     }
   } catch (const FiniteStrainError& e) {

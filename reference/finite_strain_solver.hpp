@@ -136,8 +136,17 @@ struct SolverSettings {
   /// Newton's start: the last two converged states extrapolated linearly along the trajectory
   /// (tool travel, else load factor, else time for a rate-dependent problem), u = u₁ + s (u₁ − u₀),
   /// 0 <= s <= 2; from u₁ again if Newton fails from there. The equilibrium found is the same to
-  /// the Newton tolerance.
-  bool extrapolate_initial_guess = true;
+  /// the Newton tolerance, not to the bit: the predictor's history is not part of `state()`, so a
+  /// run resumed from a checkpoint would differ from the uninterrupted one in the last digits.
+  /// Off by default for that reason.
+  bool extrapolate_initial_guess = false;
+  /// Quasi-Newton between tangents (serial direct solver): steps with the last factorised tangent
+  /// and the limited-memory BFGS updates of the steps since (Matthies & Strang 1979), a full
+  /// Newton step (tangent assembled and factorised) first in every solve, when a Dirichlet
+  /// increment is pending, and after a step that reduced |R| by less than half. Converges to the same tolerance as full Newton. Problems
+  /// with a tool in contact or a cohesive interface use full Newton (their tangent changes abruptly).
+  /// Serial only; the distributed and the iterative solvers take full Newton steps.
+  bool quasi_newton = true;
   /// Launched by mpirun with N > 1 processes: distribute the mesh over them (true), or solve the
   /// whole problem on this process alone (false, e.g. a serial comparison inside an MPI job).
   bool distribute = true;
@@ -228,6 +237,7 @@ struct EquilibriumReport {
   double assembly_seconds = 0.0;
   double linear_solve_seconds = 0.0;
   int linear_iterations = 0; ///< iterative solver: total CG iterations
+  int factorizations = 0;    ///< tangents assembled and factorised (the rest were quasi-Newton steps)
   std::string failure;       ///< why it did not converge (empty if converged)
 };
 

@@ -92,8 +92,7 @@ void SparseDirect::factorize(const std::vector<double>& values) {
   if (values.size() != m_columns.size())
     throw std::invalid_argument("SparseDirect::factorize: " + std::to_string(values.size()) + " values for a pattern of " +
                                 std::to_string(m_columns.size()) + " entries");
-  if (m_lu_only > 0) --m_lu_only;
-  else if (symmetric(values) && factorize_cholesky(values)) {
+  if (symmetric(values) && factorize_cholesky(values)) {
     m_last_cholesky = true;
     return;
   }
@@ -136,7 +135,6 @@ bool SparseDirect::factorize_cholesky(const std::vector<double>& values) {
   m_counters.factorization_seconds += seconds_since(t0);
   if (c.common.status == CHOLMOD_NOT_POSDEF || c.L->minor < m_n) {
     ++m_counters.not_positive_definite;
-    m_lu_only = 8; // an indefinite tangent tends to stay so for a while (a softening interface)
     return false;
   }
   if (c.common.status < CHOLMOD_OK)
@@ -165,8 +163,8 @@ void SparseDirect::factorize_lu(const std::vector<double>& values) {
     u.Ax.resize(u.Ai.size());
     for (std::size_t k = 0; k < u.source.size(); ++k) u.Ax[k] = values[static_cast<std::size_t>(u.source[k])];
     const auto n = static_cast<SuiteSparse_long>(m_n);
-    const SuiteSparse_long status =
-        umfpack_dl_symbolic(n, n, u.Ap.data(), u.Ai.data(), u.Ax.data(), &u.symbolic, u.control, nullptr);
+    // The pattern alone (no values): the analysis must not depend on which matrix came first.
+    const SuiteSparse_long status = umfpack_dl_symbolic(n, n, u.Ap.data(), u.Ai.data(), nullptr, &u.symbolic, u.control, nullptr);
     if (status != UMFPACK_OK)
       throw std::runtime_error("SparseDirect: UMFPACK's symbolic analysis failed (status " + std::to_string(status) + ")");
     m_counters.analysis_seconds += seconds_since(t0);

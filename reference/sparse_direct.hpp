@@ -12,6 +12,8 @@
 //   - otherwise, or when Cholesky meets a non-positive pivot (a softening interface, a buckling
 //     mode): LU with partial pivoting (UMFPACK), whose symbolic analysis is also kept.
 // Both solve to machine precision: the answer differs from any other direct solver's by rounding.
+// The choice depends on the matrix alone (no state carried between factorisations), so that the
+// same matrix always gets the same factors.
 //
 // Plain C++ (SuiteSparse's C interface inside the .cpp): no deal.II in this header.
 
@@ -62,8 +64,6 @@ private:
   std::unique_ptr<Cholmod> m_cholmod;
   std::unique_ptr<Umfpack> m_umfpack;
   bool m_last_cholesky = false;
-  /// After Cholesky fails, LU is used for this many factorisations before Cholesky is tried again.
-  int m_lu_only = 0;
   mutable Counters m_counters;
   [[nodiscard]] bool symmetric(const std::vector<double>& values) const;
   bool factorize_cholesky(const std::vector<double>& values);

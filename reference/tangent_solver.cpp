@@ -108,7 +108,9 @@ void TangentSolver::factorize(const dealii::SparseMatrix<double>& K) {
   std::size_t k = 0;
   for (std::size_t r = 0; r < K.m(); ++r)
     for (auto it = K.begin(r); it != K.end(r); ++it) m_values[k++] = it->value();
+  m_factorized = false;
   m_direct->factorize(m_values);
+  m_factorized = true;
 }
 
 void TangentSolver::solve_factorized(dealii::Vector<double>& x, const dealii::Vector<double>& b) const {

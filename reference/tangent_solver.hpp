@@ -46,6 +46,8 @@ public:
   int solve(const dealii::SparseMatrix<double>& K, dealii::Vector<double>& x, const dealii::Vector<double>& b);
   /// Serial direct solver only: factorises K (kept for `solve_factorized`).
   void factorize(const dealii::SparseMatrix<double>& K);
+  /// Serial direct solver: whether a factorisation is at hand (the last `factorize` succeeded).
+  [[nodiscard]] bool factorized() const { return m_factorized; }
   /// Serial direct solver only: solves K x = b with the last factorisation.
   void solve_factorized(dealii::Vector<double>& x, const dealii::Vector<double>& b) const;
   /// Serial direct solver: its counters (factorisations, times); nullptr before the first solve.
@@ -68,6 +70,7 @@ private:
   std::unique_ptr<Petsc> m_petsc;
   std::unique_ptr<SparseDirect> m_direct; ///< serial direct: built from K's pattern on first use
   std::vector<double> m_values;           ///< K's values in its pattern's order
+  bool m_factorized = false;
   bool m_distributed;
   bool m_spd;
 };
