@@ -28,6 +28,9 @@ struct SparseDirect::Cholmod {
   Cholmod() {
     cholmod_l_start(&common);
     common.quick_return_if_not_posdef = 1; // a failed factorisation stops at the first bad pivot
+    // Always the supernodal L Lᵀ: CHOLMOD's simplicial LDLᵀ (its choice for small, sparse factors)
+    // would factorise an indefinite matrix without pivoting instead of reporting it.
+    common.supernodal = CHOLMOD_SUPERNODAL;
   }
   ~Cholmod() {
     if (L) cholmod_l_free_factor(&L, &common);
