@@ -8,7 +8,7 @@
 #   equal accuracy: kerf R× faster than FEBio (…)
 #   same mesh: kerf R× faster than FEBio (…)
 # (R < 1: kerf is slower). "Equal accuracy" pairs each FEBio run with the cheapest kerf run whose
-# tip error is no larger; the error is against the Richardson extrapolation of kerf's three finest
+# tip error is no larger (within 5 %); the error is against the Richardson extrapolation of kerf's three finest
 # meshes. The .msh/.feb inputs are written by `cook_febio mesh H DIR` from
 # experiments/benchmarks/cook/cook_membrane.geo (gmsh, through kerf); regenerate with --mesh.
 #
@@ -106,7 +106,9 @@ for h, tf, tipf, _ in febio:
     if ("kerf", h) in rows:
         same.append((h, tf / rows[("kerf", h)][0]))
     err = abs(tipf - ref)
-    ok = [(t, hk) for hk, t, tip, _ in kerf if abs(tip - ref) <= err]
+    # Within 5 % of FEBio's error counts as equal (FEBio's looser convergence test moves its tip by
+    # ~1e-4 mm on the same discretisation).
+    ok = [(t, hk) for hk, t, tip, _ in kerf if abs(tip - ref) <= 1.05 * err]
     if ok:
         t, hk = min(ok)
         equal.append((h, hk, tf / t))
