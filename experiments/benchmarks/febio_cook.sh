@@ -15,7 +15,8 @@
 # FEBio is built from its public source in a scratch folder, never committed:
 #   git clone https://github.com/febiosoftware/FEBio /tmp/febio-src
 #   cmake -S /tmp/febio-src -B /tmp/febio-build -DCMAKE_BUILD_TYPE=Release \
-#         -DCMAKE_CXX_FLAGS="-include cstring" -DUSE_MKL=OFF -DUSE_HYPRE=OFF -DUSE_MMG=OFF -DUSE_LEVMAR=OFF
+#         -DCMAKE_CXX_FLAGS="-include cstring" -DUSE_MKL=OFF -DUSE_HYPRE=OFF -DUSE_MMG=OFF -DUSE_LEVMAR=OFF \
+#         -DCMAKE_EXE_LINKER_FLAGS=-fopenmp -DCMAKE_SHARED_LINKER_FLAGS=-fopenmp   # OpenMP at link without MKL
 #   nice -n 19 make -C /tmp/febio-build -j2 febio4        # ~10 min on 2 idle cores
 #   export FEBIO=/tmp/febio-build/bin/febio4
 # Without MKL FEBio solves with its skyline solver (hence optimize_bw 1 in the inputs).
