@@ -108,8 +108,9 @@ struct SerialAlgebra {
   std::size_t n = 0;
   dealii::SparsityPattern pattern;
   MatrixType K;
-  VectorType u;         ///< the displacement DOFs
-  VectorType free_mask; ///< 1 on free DOFs, 0 on Dirichlet DOFs
+  VectorType u;          ///< the displacement DOFs
+  VectorType u_previous; ///< the converged state before the last one (the predictor's u₀)
+  VectorType free_mask;  ///< 1 on free DOFs, 0 on Dirichlet DOFs
   void reinit(VectorType& v) const { v.reinit(n); }
   /// The vector with the values every cell of this process reads: itself.
   const VectorType& ghosted(const VectorType& v) const { return v; }
@@ -126,6 +127,7 @@ struct DistributedAlgebra {
   dealii::IndexSet owned, relevant;
   MatrixType K;
   VectorType u;
+  VectorType u_previous; ///< the converged state before the last one (the predictor's u₀)
   VectorType free_mask;
   mutable VectorType ghost; ///< locally relevant values of the last vector passed to ghosted()
   void reinit(VectorType& v) const { v.reinit(owned, comm); }
@@ -204,6 +206,21 @@ struct FiniteStrainSolver::Impl {
     Eigen::Vector3d X;
   };
   std::vector<DirichletDof> dirichlet;
+
+  // The reference geometry of every cell, computed once (total Lagrangian: the shape gradients
+  // with respect to X and the weights JxW never change): per active cell index, the scalar
+  // FE_SimplexP shape gradients [q][node][3] and JxW[q]. A cell's DOF i is component comp(i) of
+  // scalar node node_of_dof[i], and Grad N_i = e_comp ⊗ gradient of that node.
+  struct CellGeometry {
+    unsigned nodes = 0, points = 0;
+    std::vector<unsigned> node_of_dof;
+    std::vector<double> gradients; // cell × points × nodes × 3
+    std::vector<double> JxW;       // cell × points
+    [[nodiscard]] const double* gradient(std::size_t cell, unsigned q, unsigned node) const {
+      return &gradients[((cell * points + q) * nodes + node) * 3];
+    }
+  } geometry;
+  void build_cell_geometry();
   std::vector<DisplacementBoundary> boundaries;
   std::vector<std::pair<int, Eigen::Vector3d>> tractions; // surface group, traction [Pa]
   std::vector<std::vector<int>> face_classes;               // boundary_id -> surface groups
@@ -328,6 +345,25 @@ struct FiniteStrainSolver::Impl {
                       const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
                       VectorType& f_int, VectorType& f_ext) const;
   template <class Algebra> EquilibriumReport solve(Algebra& la, const LoadState& load);
+  /// Newton–Raphson from the state in `la.u` (the predictor's or `start`); on failure `la.u` is
+  /// set back to `start`, the last converged state.
+  template <class Algebra>
+  EquilibriumReport newton(Algebra& la, const LoadState& load, const typename Algebra::VectorType& start);
+  /// The Dirichlet constraints of the state `u`: the remaining increment target − u on every
+  /// Dirichlet DOF (added to `c`, which is closed). Returns the largest |target − u| (all processes).
+  template <class Algebra>
+  double dirichlet_constraints(const Algebra& la, const typename Algebra::VectorType& u, const LoadState& load,
+                               dealii::AffineConstraints<double>& c) const;
+
+  // The predictor (SolverSettings::extrapolate_initial_guess): the last two converged loads. The
+  // states are la.u (at `load_last`) and la.u_previous (at `load_before`); `history` counts the
+  // known ones (0, 1 or 2), reset by set_state.
+  int history = 0;
+  LoadState load_last, load_before;
+  /// s of the linear extrapolation u = u₁ + s (u₁ − u₀) to `load` (0: no predictor).
+  [[nodiscard]] double extrapolation_factor(const LoadState& load) const;
+  bool fault_fired = false; // the fault injection poisoned an assembly of the solve under way
+
   /// The fields of the displacement `u` (locally relevant values) to `file` (see write_fields).
   template <class VectorType>
   void write_fields(const VectorType& u, const std::filesystem::path& file, const LoadState& load) const;
@@ -452,6 +488,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   else
     dof.reinit(tria);
   dof.distribute_dofs(*fe);
+  build_cell_geometry();
 
   // Support points; the node-major layout (3k + component) the AMG's block size relies on.
   std::vector<dealii::Point<3>> support(dof.n_dofs());
@@ -585,6 +622,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     serial.pattern.copy_from(dsp);
     serial.K.reinit(serial.pattern);
     serial.u.reinit(dof.n_dofs());
+    serial.u_previous.reinit(dof.n_dofs());
     serial.free_mask.reinit(dof.n_dofs());
     serial.free_mask = 1.0;
     for (const auto& d : dirichlet) serial.free_mask[d.index] = 0.0;
@@ -607,6 +645,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   dealii::SparsityTools::distribute_sparsity_pattern(dsp, la.owned, la.comm, la.relevant);
   la.K.reinit(la.owned, la.owned, dsp, la.comm);
   la.reinit(la.u);
+  la.reinit(la.u_previous);
   la.ghost.reinit(la.owned, la.relevant, la.comm);
   la.reinit(la.free_mask);
   la.free_mask = 1.0;
@@ -689,13 +728,12 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
                                               MatrixType& K, VectorType* rhs, VectorType& f_int,
                                               VectorType& f_ext) const {
   const unsigned n = fe->n_dofs_per_cell();
-  dealii::FEValues<3> fv(*mapping, *fe, *cell_quadrature,
-                         dealii::update_gradients | dealii::update_JxW_values);
+  const CellGeometry& geo = geometry;
   dealii::FEFaceValues<3> ffv(*mapping, *fe, *face_quadrature,
                               dealii::update_values | dealii::update_quadrature_points | dealii::update_JxW_values);
   const dealii::FEValuesExtractors::Vector disp(0);
-  std::vector<dealii::Tensor<2, 3>> grads(cell_quadrature->size());
   std::vector<dealii::Tensor<1, 3>> face_u(face_quadrature->size());
+  std::vector<double> cell_u(n);
   dealii::FullMatrix<double> cell_K(n, n);
   dealii::Vector<double> cell_int(n), cell_ext(n), cell_rhs(n);
   std::vector<dealii::types::global_dof_index> local(n);
@@ -707,12 +745,12 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
 
   for (const auto& cell : dof.active_cell_iterators()) {
     if (!cell->is_locally_owned()) continue; // distributed: another process assembles it
-    fv.reinit(cell);
     cell->get_dof_indices(local);
+    const std::size_t c_index = cell->active_cell_index();
+    for (unsigned i = 0; i < n; ++i) cell_u[i] = state(local[i]);
     cell_K = 0.0;
     cell_int = 0.0;
     cell_ext = 0.0;
-    fv[disp].get_function_gradients(state, grads);
     const HyperelasticLaw& law = *laws[cell->material_id()];
     if (dynamics && dynamics->step > 0.0) {
       // Inertia (Newmark β = 1/4): f_a += Σ_b M_ab a_b(u), a_b = 4/h² (u_b − u_n,b) − 4/h v_n,b − a_n,b,
@@ -733,17 +771,22 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
                         damping[cell->material_id()].retardation_time > 0.0;
     if (damped)
       for (unsigned i = 0; i < n; ++i) velocity[i] = newmark_velocity(local[i], state(local[i]));
-    for (unsigned q = 0; q < fv.n_quadrature_points; ++q) {
-      // F = I + Grad u (total Lagrangian: gradients with respect to the reference configuration)
-      const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + to_eigen(grads[q]);
-      const double JxW = fv.JxW(q);
-      Eigen::Matrix3d S;
-      Tensor4 C4;
-      law.second_piola_and_tangent(F, S, C4);
-      StressTangent st = first_piola_and_tangent(F, S, C4);
-      for (unsigned i = 0; i < n; ++i) {
-        const auto g = fv.shape_grad_component(i, q, comp[i]);
-        gradN[i] = Eigen::Vector3d(g[0], g[1], g[2]);
+    for (unsigned q = 0; q < geo.points; ++q) {
+      for (unsigned i = 0; i < n; ++i) gradN[i] = Eigen::Map<const Eigen::Vector3d>(geo.gradient(c_index, q, geo.node_of_dof[i]));
+      // F = I + Grad u = I + Σ_a u_a e_c ⊗ Grad N_a (total Lagrangian: gradients with respect to
+      // the reference configuration)
+      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+      for (unsigned i = 0; i < n; ++i) F.row(comp[i]) += cell_u[i] * gradN[i].transpose();
+      const double JxW = geo.JxW[c_index * geo.points + q];
+      // The residual-only assemblies of the line search need P = F S alone (the same bits).
+      StressTangent st;
+      if (with_matrix) {
+        Eigen::Matrix3d S;
+        Tensor4 C4;
+        law.second_piola_and_tangent(F, S, C4);
+        st = first_piola_and_tangent(F, S, C4);
+      } else {
+        st.first_piola = F * law.second_piola(F);
       }
       if (damped) {
         // Ḟ = Grad v = Σ_a v_a e_c ⊗ Grad N_a; P += P_v(F, Ḟ), 𝔸 += ∂P_v/∂F with ∂Ḟ/∂F = γ/(βh) = 2/h.
@@ -756,12 +799,17 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
       // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
       for (unsigned i = 0; i < n; ++i) cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
       if (!with_matrix) continue;
-      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV
+      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV; 𝔸 of a hyperelastic law has the
+      // major symmetry 𝔸_iJkL = 𝔸_kLiJ, so K is symmetric: its upper triangle here, the lower one
+      // mirrored below (the Kelvin–Voigt tangent has no such symmetry: then every entry).
       for (unsigned j = 0; j < n; ++j) AgradN[j] = st.tangent.middleCols<3>(3 * comp[j]) * gradN[j];
       for (unsigned i = 0; i < n; ++i)
-        for (unsigned j = 0; j < n; ++j)
+        for (unsigned j = damped ? 0 : i; j < n; ++j)
           cell_K(i, j) += gradN[i].dot(AgradN[j].segment<3>(3 * comp[i])) * JxW;
     }
+    if (with_matrix && !damped)
+      for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = 0; j < i; ++j) cell_K(i, j) = cell_K(j, i);
 
     // Tractions and contact on boundary faces.
     for (const unsigned f : cell->face_indices()) {
@@ -821,6 +869,30 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
     }
   }
   if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);
+}
+
+void FiniteStrainSolver::Impl::build_cell_geometry() {
+  const dealii::FE_SimplexP<3> scalar(static_cast<unsigned>(settings.degree));
+  CellGeometry& g = geometry;
+  g.nodes = scalar.n_dofs_per_cell();
+  g.points = cell_quadrature->size();
+  const unsigned n = fe->n_dofs_per_cell();
+  g.node_of_dof.resize(n);
+  for (unsigned i = 0; i < n; ++i) g.node_of_dof[i] = fe->system_to_component_index(i).second;
+  const std::size_t cells = dof.get_triangulation().n_active_cells();
+  g.gradients.assign(cells * g.points * g.nodes * 3, 0.0);
+  g.JxW.assign(cells * g.points, 0.0);
+  dealii::FEValues<3> fv(*mapping, scalar, *cell_quadrature, dealii::update_gradients | dealii::update_JxW_values);
+  for (const auto& cell : dof.get_triangulation().active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue;
+    fv.reinit(cell);
+    const std::size_t c = cell->active_cell_index();
+    for (unsigned q = 0; q < g.points; ++q) {
+      g.JxW[c * g.points + q] = fv.JxW(q);
+      for (unsigned a = 0; a < g.nodes; ++a)
+        for (unsigned d = 0; d < 3; ++d) g.gradients[((c * g.points + q) * g.nodes + a) * 3 + d] = fv.shape_grad(a, q)[d];
+    }
+  }
 }
 
 void FiniteStrainSolver::Impl::build_dynamics() {
@@ -1241,17 +1313,133 @@ EquilibriumReport FiniteStrainSolver::solve(const LoadState& load) {
   return m_impl->with_algebra([&](auto& la) { return m_impl->solve(la, load); });
 }
 
+double FiniteStrainSolver::Impl::extrapolation_factor(const LoadState& load) const {
+  if (history < 2) return 0.0;
+  const LoadState& l1 = load_last;
+  const LoadState& l0 = load_before;
+  // The load's parameter along the trajectory: the tool's travel, else the load factor; the time
+  // when only time moves the problem (inertia, a viscous interface). A dwell (same load) keeps u₁.
+  const bool same_load = load.load_factor == l1.load_factor && load.tool_position == l1.tool_position;
+  const bool rate_dependent = dynamics.has_value() || (cohesive_law && cohesive_law->viscosity > 0.0);
+  double s = 0.0;
+  const Eigen::Vector3d d = l1.tool_position - l0.tool_position;
+  if (same_load && !rate_dependent) {
+    s = 0.0;
+  } else if (d.squaredNorm() > 0.0) {
+    s = (load.tool_position - l1.tool_position).dot(d) / d.squaredNorm();
+  } else if (l1.load_factor != l0.load_factor) {
+    s = (load.load_factor - l1.load_factor) / (l1.load_factor - l0.load_factor);
+  } else if (rate_dependent && l1.time != l0.time) {
+    s = (load.time - l1.time) / (l1.time - l0.time);
+  }
+  // Forward only, and at most twice the last increment: a start guess, never a leap.
+  return std::isfinite(s) ? std::clamp(s, 0.0, 2.0) : 0.0;
+}
+
 template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algebra& la, const LoadState& load) {
   using VectorType = typename Algebra::VectorType;
   Impl& m = *this;
-  EquilibriumReport report;
   const VectorType start = la.u;
-  Impl::Assembly<VectorType> assembly;
-  VectorType rhs, du;
-  la.reinit(rhs);
-  la.reinit(du);
   // Dynamic step: h from the last converged time (0: a quasi-static solve, no inertia).
   if (m.dynamics) m.dynamics->step = std::max(0.0, load.time - m.committed_time);
+  m.fault_fired = false;
+  // The predictor: the last two converged states extrapolated linearly along the trajectory,
+  // u = u₁ + s (u₁ − u₀). Only Newton's start changes; the equilibrium it converges to is the same
+  // (to the Newton tolerance). Should Newton fail from there, it starts again from u₁.
+  const double s = m.settings.extrapolate_initial_guess ? m.extrapolation_factor(load) : 0.0;
+  EquilibriumReport report;
+  if (s > 0.0) {
+    la.u *= 1.0 + s;
+    la.u.add(-s, la.u_previous);
+    report = m.newton(la, load, start);
+    if (!report.converged && !m.fault_fired) {
+      EquilibriumReport again = m.newton(la, load, start);
+      again.newton_iterations += report.newton_iterations;
+      again.assembly_seconds += report.assembly_seconds;
+      again.linear_solve_seconds += report.linear_solve_seconds;
+      again.linear_iterations += report.linear_iterations;
+      again.factorizations += report.factorizations;
+      report = std::move(again);
+    }
+  } else {
+    report = m.newton(la, load, start);
+  }
+  if (!report.converged) return report;
+  la.u_previous = start;
+  m.load_before = m.load_last;
+  m.load_last = load;
+  m.history = std::min(2, m.history + 1);
+  return report;
+}
+
+template <class Algebra>
+double FiniteStrainSolver::Impl::dirichlet_constraints(const Algebra& la, const typename Algebra::VectorType& u,
+                                                      const LoadState& load,
+                                                      dealii::AffineConstraints<double>& c) const {
+  c.clear();
+  la.prepare(c);
+  const auto& u_relevant = la.ghosted(u);
+  double mismatch = 0.0;
+  for (const auto& d : dirichlet) {
+    const double g = dirichlet_target(d, load.load_factor) - u_relevant[d.index];
+    mismatch = std::max(mismatch, std::abs(g));
+    c.add_line(d.index);
+    c.set_inhomogeneity(d.index, g);
+  }
+  c.close();
+  return max(mismatch);
+}
+
+template <class Algebra>
+EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState& load,
+                                                   const typename Algebra::VectorType& start) {
+  using VectorType = typename Algebra::VectorType;
+  constexpr bool serial_algebra = std::is_same_v<VectorType, dealii::Vector<double>>;
+  Impl& m = *this;
+  EquilibriumReport report;
+  // `assembly` (with la.K, `rhs` and `constraints` when `with_tangent`) is the assembly of the
+  // current state la.u when `assembled`. A Newton step assembles its full step (α = 1) with the
+  // tangent, so that when it is accepted the next Newton step starts from it.
+  Impl::Assembly<VectorType> assembly, full, trial;
+  VectorType rhs, full_rhs, du;
+  la.reinit(rhs);
+  la.reinit(full_rhs);
+  la.reinit(du);
+  dealii::AffineConstraints<double> constraints, full_constraints;
+  double mismatch = 0.0;
+  bool assembled = false, with_tangent = false;
+  // Quasi-Newton (SolverSettings::quasi_newton; serial direct solver): steps with the last
+  // factorised tangent K₀ corrected by the BFGS updates of the steps since (limited memory, the
+  // two-loop recursion with H₀ = K₀⁻¹; Matthies & Strang 1979, Nocedal 1980). A full Newton step
+  // (tangent assembled and factorised) is taken when a Dirichlet increment is pending, when no
+  // factorisation exists, and after a quasi-Newton step that reduced |R| by less than half, did
+  // not reduce it, or used up the updates.
+  // Contact and a cohesive interface change the tangent abruptly (points enter and leave the
+  // contact set, the interface softens): there the updates converge slowly, and full Newton is used.
+  // Every solve starts with a Newton step (FEBio's "reform each time step"), so that a solve
+  // depends on its start state alone (a run resumed from a checkpoint repeats it bit for bit).
+  const bool quasi_newton_allowed = serial_algebra && m.settings.quasi_newton && !m.tool && !m.cohesive_law &&
+                                    m.linear->kind() == TangentSolver::Kind::direct;
+  bool newton_next = true;
+  std::vector<VectorType> S, Y; // the steps s = Δu and residual changes y = ΔR of the updates
+  std::vector<double> rho;      // 1 / (yᵀ s)
+  constexpr std::size_t max_updates = 10;
+  // Fault injection: asked once per iteration (the full step's assembly asks for the next one).
+  int fault_asked = -1;
+  bool fault_answer = false;
+  auto fault = [&](int it) {
+    if (!m.settings.residual_fault) return false;
+    if (fault_asked != it) {
+      fault_asked = it;
+      fault_answer = m.settings.residual_fault(load, it);
+    }
+    m.fault_fired = m.fault_fired || fault_answer;
+    return fault_answer;
+  };
+  // A cohesive interface whose points switch between loading and unloading can make the
+  // consistent Newton iteration cycle; after a third of the allowed iterations the secant
+  // interface tangent takes over (slower, but it does not cycle). It changes the tangent only.
+  auto secant = [&](int it) { return m.cohesive_law.has_value() && it >= m.settings.max_newton_iterations / 3; };
   auto fail = [&](std::string why) {
     la.u = start;
     report.converged = false;
@@ -1260,28 +1448,18 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
   };
   try {
     for (int it = 0;; ++it) {
-      // Constraints of this iteration: the remaining Dirichlet increment target − u.
-      dealii::AffineConstraints<double> constraints;
-      la.prepare(constraints);
-      const VectorType& u_relevant = la.ghosted(la.u);
-      double mismatch = 0.0;
-      for (const auto& d : m.dirichlet) {
-        const double g = m.dirichlet_target(d, load.load_factor) - u_relevant[d.index];
-        mismatch = std::max(mismatch, std::abs(g));
-        constraints.add_line(d.index);
-        constraints.set_inhomogeneity(d.index, g);
-      }
-      constraints.close();
-      mismatch = m.max(mismatch);
-      // A cohesive interface whose points switch between loading and unloading can make the
-      // consistent Newton iteration cycle; after a third of the allowed iterations the secant
-      // interface tangent takes over (slower, but it does not cycle).
-      m.cohesive_secant = m.cohesive_law && it >= m.settings.max_newton_iterations / 3;
       auto t0 = Clock::now();
-      m.poison_residual = m.settings.residual_fault && m.settings.residual_fault(load, it);
-      m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
-      m.poison_residual = false;
-      report.assembly_seconds += seconds_since(t0);
+      if (!assembled) {
+        mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
+        m.cohesive_secant = secant(it);
+        m.poison_residual = fault(it);
+        with_tangent = newton_next || mismatch > 0.0;
+        m.assemble(la, la.u, load, with_tangent, assembly, with_tangent ? &constraints : nullptr,
+                   with_tangent ? &rhs : nullptr);
+        m.poison_residual = false;
+        report.assembly_seconds += seconds_since(t0);
+      }
+      assembled = false;
       const double r = m.free_norm(assembly.residual, la.free_mask);
       report.residual_history.push_back(r);
       const double scale = assembly.internal_norm + assembly.external_norm;
@@ -1293,10 +1471,40 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
       }
       if (it >= m.settings.max_newton_iterations)
         return fail("no convergence in " + std::to_string(m.settings.max_newton_iterations) + " Newton iterations");
+      const bool newton_step = newton_next || mismatch > 0.0 || !quasi_newton_allowed;
+      if (newton_step && !with_tangent) {
+        // The state's residual came from a line search: its tangent is assembled now.
+        t0 = Clock::now();
+        m.cohesive_secant = secant(it);
+        m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
+        report.assembly_seconds += seconds_since(t0);
+      }
       t0 = Clock::now();
-      report.linear_iterations += m.linear->solve(la.K, du, rhs);
+      if (newton_step) {
+        report.linear_iterations += m.linear->solve(la.K, du, rhs);
+        constraints.distribute(du);
+        ++report.factorizations;
+        S.clear();
+        Y.clear();
+        rho.clear();
+      } else if constexpr (serial_algebra) {
+        // du = −H R over the free DOFs: the two-loop recursion around K₀⁻¹.
+        VectorType q = assembly.residual;
+        q.scale(la.free_mask);
+        q *= -1.0;
+        std::vector<double> alpha_k(S.size());
+        for (std::size_t k = S.size(); k-- > 0;) {
+          alpha_k[k] = rho[k] * (S[k] * q);
+          q.add(-alpha_k[k], Y[k]);
+        }
+        m.linear->solve_factorized(du, q);
+        du.scale(la.free_mask);
+        for (std::size_t k = 0; k < S.size(); ++k) {
+          const double beta = rho[k] * (Y[k] * du);
+          du.add(alpha_k[k] - beta, S[k]);
+        }
+      }
       report.linear_solve_seconds += seconds_since(t0);
-      constraints.distribute(du);
       ++report.newton_iterations;
       // Backtracking line search on the free residual: the first α in 1, ½, … (6 tries) that keeps
       // every element valid and reduces |R|, else the valid α with the smallest |R|. While a
@@ -1304,18 +1512,43 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
       // must grow with the imposed displacement): then the largest valid α is taken.
       const VectorType base = la.u;
       double best_alpha = 0.0, best_r = std::numeric_limits<double>::infinity();
-      Impl::Assembly<VectorType> trial;
+      bool full_valid = false, full_tangent = false;
+      double full_mismatch = 0.0;
       for (double alpha = 1.0; alpha > 1.0 / 64.0; alpha *= 0.5) {
         la.u = base;
         la.u.add(alpha, du);
-        try {
-          t0 = Clock::now();
-          m.assemble(la, la.u, load, false, trial, nullptr, nullptr);
-          report.assembly_seconds += seconds_since(t0);
-        } catch (const FiniteStrainError&) {
-          continue;
+        Impl::Assembly<VectorType>& a = alpha == 1.0 ? full : trial;
+        t0 = Clock::now();
+        if (alpha == 1.0) {
+          // The full step, assembled as the next iteration would (its constraints, fault; the
+          // tangent when this step is a Newton step, whose successor is likely one too).
+          full_mismatch = m.dirichlet_constraints(la, la.u, load, full_constraints);
+          m.cohesive_secant = secant(it + 1);
+          const bool poisoned = fault(it + 1);
+          m.poison_residual = poisoned;
+          full_tangent = newton_step || !quasi_newton_allowed;
+          try {
+            m.assemble(la, la.u, load, full_tangent, full, full_tangent ? &full_constraints : nullptr,
+                       full_tangent ? &full_rhs : nullptr);
+          } catch (const FiniteStrainError&) {
+            m.poison_residual = false;
+            report.assembly_seconds += seconds_since(t0);
+            if (poisoned) throw FiniteStrainError("finite strain: non-finite residual");
+            continue;
+          }
+          m.poison_residual = false;
+          full_valid = true;
+        } else {
+          m.cohesive_secant = secant(it);
+          try {
+            m.assemble(la, la.u, load, false, trial, nullptr, nullptr);
+          } catch (const FiniteStrainError&) {
+            report.assembly_seconds += seconds_since(t0);
+            continue;
+          }
         }
-        const double rt = m.free_norm(trial.residual, la.free_mask);
+        report.assembly_seconds += seconds_since(t0);
+        const double rt = m.free_norm(a.residual, la.free_mask);
         if (rt < best_r) {
           best_r = rt;
           best_alpha = alpha;
@@ -1325,9 +1558,62 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
           break;
         }
       }
+      if (!newton_step && !(best_r < r)) {
+        // The quasi-Newton direction does not reduce |R|: back to the state, a Newton step next.
+        la.u = base;
+        newton_next = true;
+        assembled = true; // the residual is still the state's (its tangent is assembled above)
+        with_tangent = false;
+        continue;
+      }
       if (best_alpha == 0.0) return fail("every line-search step inverts an element");
       la.u = base;
       la.u.add(best_alpha, du);
+      if constexpr (serial_algebra) {
+        if (quasi_newton_allowed) {
+          // The BFGS update of this step, when the accepted state's residual is at hand: s = Δu,
+          // y = ΔR over the free DOFs, kept while yᵀ s > 0 (the curvature condition).
+          const Impl::Assembly<VectorType>* accepted =
+              best_alpha == 1.0 ? (full_valid ? &full : nullptr) : &trial;
+          const bool last_trial_is_best = best_alpha == 1.0 || best_r == m.free_norm(trial.residual, la.free_mask);
+          if (accepted != nullptr && last_trial_is_best) {
+            VectorType s = du;
+            s *= best_alpha;
+            s.scale(la.free_mask);
+            VectorType y = accepted->residual;
+            y -= assembly.residual;
+            y.scale(la.free_mask);
+            const double ys = y * s;
+            if (ys > 0.0) {
+              S.push_back(std::move(s));
+              Y.push_back(std::move(y));
+              rho.push_back(1.0 / ys);
+            }
+          }
+          newton_next = !(best_r <= 0.5 * r) || S.size() >= max_updates;
+        }
+      }
+      if (best_alpha == 1.0 && full_valid) {
+        std::swap(assembly, full);
+        if (full_tangent) {
+          rhs.swap(full_rhs);
+          std::swap(constraints, full_constraints);
+        } else {
+          constraints.clear(); // residual only: constraints are rebuilt if a Newton step follows
+          full_mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
+        }
+        mismatch = full_mismatch;
+        with_tangent = full_tangent;
+        assembled = true;
+      } else if (!newton_step || quasi_newton_allowed) {
+        // A shortened step: the last trial is the accepted state's residual when it was the best.
+        if (best_alpha < 1.0 && best_r == m.free_norm(trial.residual, la.free_mask)) {
+          std::swap(assembly, trial);
+          mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
+          with_tangent = false; // a Newton step next assembles the tangent at the loop's top
+          assembled = true;
+        }
+      }
     }
   } catch (const FiniteStrainError& e) {
     m.poison_residual = false;
@@ -1502,6 +1788,7 @@ std::vector<double> FiniteStrainSolver::state() const {
 
 void FiniteStrainSolver::set_state(const std::vector<double>& values) {
   Impl& m = *m_impl;
+  m.history = 0; // the predictor starts over from the restored state
   const std::size_t n_dofs = m.dof.n_dofs();
   const std::size_t damped = m.dynamics && m.dynamics->damped ? 1 : 0;
   const std::size_t expected = n_dofs + (m.cohesive_law ? 4 * m.cohesive_states.size() + 2 : 0) +

@@ -133,6 +133,20 @@ struct SolverSettings {
   double edge_line_penalty = 0.0;
   /// Blade edge pass: edge point spacing [m]; 0 = automatic, h_min / 4.
   double edge_point_spacing = 0.0;
+  /// Newton's start: the last two converged states extrapolated linearly along the trajectory
+  /// (tool travel, else load factor, else time for a rate-dependent problem), u = u₁ + s (u₁ − u₀),
+  /// 0 <= s <= 2; from u₁ again if Newton fails from there. The equilibrium found is the same to
+  /// the Newton tolerance, not to the bit: the predictor's history is not part of `state()`, so a
+  /// run resumed from a checkpoint would differ from the uninterrupted one in the last digits.
+  /// Off by default for that reason.
+  bool extrapolate_initial_guess = false;
+  /// Quasi-Newton between tangents (serial direct solver): steps with the last factorised tangent
+  /// and the limited-memory BFGS updates of the steps since (Matthies & Strang 1979), a full
+  /// Newton step (tangent assembled and factorised) first in every solve, when a Dirichlet
+  /// increment is pending, and after a step that reduced |R| by less than half. Converges to the same tolerance as full Newton. Problems
+  /// with a tool in contact or a cohesive interface use full Newton (their tangent changes abruptly).
+  /// Serial only; the distributed and the iterative solvers take full Newton steps.
+  bool quasi_newton = true;
   /// Launched by mpirun with N > 1 processes: distribute the mesh over them (true), or solve the
   /// whole problem on this process alone (false, e.g. a serial comparison inside an MPI job).
   bool distribute = true;
@@ -223,6 +237,7 @@ struct EquilibriumReport {
   double assembly_seconds = 0.0;
   double linear_solve_seconds = 0.0;
   int linear_iterations = 0; ///< iterative solver: total CG iterations
+  int factorizations = 0;    ///< tangents assembled and factorised (the rest were quasi-Newton steps)
   std::string failure;       ///< why it did not converge (empty if converged)
 };
 
@@ -246,7 +261,8 @@ public:
 
   [[nodiscard]] std::size_t dof_count() const;
   [[nodiscard]] std::size_t cell_count() const;
-  /// "umfpack", "mumps" (distributed direct) or "petsc-cg-gamg": what `solve` uses.
+  /// "cholmod/umfpack" (serial direct, sparse_direct.hpp), "mumps" (distributed direct) or
+  /// "petsc-cg-gamg": what `solve` uses.
   [[nodiscard]] std::string linear_solver_name() const;
   /// The contact penalty in use [Pa/m].
   [[nodiscard]] double contact_penalty() const;

@@ -2,7 +2,6 @@
 
 #include "reference/mpi_processes.hpp"
 
-#include <deal.II/lac/sparse_direct.h>
 
 #include <petscksp.h>
 
@@ -89,15 +88,41 @@ TangentSolver::~TangentSolver() = default;
 
 std::string TangentSolver::name() const {
   if (m_kind == Kind::iterative) return m_spd ? "petsc-cg-gamg" : "petsc-gmres-gamg";
-  return m_distributed ? "mumps" : "umfpack";
+  return m_distributed ? "mumps" : "cholmod/umfpack";
+}
+
+void TangentSolver::factorize(const dealii::SparseMatrix<double>& K) {
+  if (m_kind != Kind::direct || m_distributed) throw std::logic_error("TangentSolver::factorize: serial direct solver only");
+  const dealii::SparsityPattern& pattern = K.get_sparsity_pattern();
+  if (!m_direct) {
+    // The pattern in deal.II's storage order (each row's diagonal first), once per problem.
+    std::vector<std::int64_t> row_start{0}, columns;
+    columns.reserve(pattern.n_nonzero_elements());
+    for (std::size_t r = 0; r < K.m(); ++r) {
+      for (auto it = pattern.begin(r); it != pattern.end(r); ++it) columns.push_back(static_cast<std::int64_t>(it->column()));
+      row_start.push_back(static_cast<std::int64_t>(columns.size()));
+    }
+    m_values.resize(columns.size());
+    m_direct = std::make_unique<SparseDirect>(K.m(), std::move(row_start), std::move(columns));
+  }
+  std::size_t k = 0;
+  for (std::size_t r = 0; r < K.m(); ++r)
+    for (auto it = K.begin(r); it != K.end(r); ++it) m_values[k++] = it->value();
+  m_factorized = false;
+  m_direct->factorize(m_values);
+  m_factorized = true;
+}
+
+void TangentSolver::solve_factorized(dealii::Vector<double>& x, const dealii::Vector<double>& b) const {
+  if (!m_direct) throw std::logic_error("TangentSolver::solve_factorized: no factorisation");
+  m_direct->solve(b.begin(), x.begin());
 }
 
 int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<double>& x,
                          const dealii::Vector<double>& b) {
   if (m_kind == Kind::direct) {
-    dealii::SparseDirectUMFPACK umfpack;
-    umfpack.initialize(K);
-    umfpack.vmult(x, b);
+    factorize(K);
+    solve_factorized(x, b);
     return 0;
   }
   initialize_petsc();

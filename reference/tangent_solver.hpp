@@ -1,5 +1,7 @@
 #pragma once
-// TangentSolver: solves one Newton step's linear system K du = b — UMFPACK for small systems,
+// TangentSolver: solves one Newton step's linear system K du = b — a direct factorisation for
+// small systems (sparse_direct.hpp: CHOLMOD's Cholesky when K is symmetric positive definite,
+// UMFPACK's LU otherwise, the symbolic analysis done once per problem),
 // PETSc CG (or GMRES) preconditioned by GAMG with elasticity's six rigid-body modes as near null
 // space for large ones (../shared/notes/dealii-on-debian12.md: without them AMG loses to Jacobi).
 // CG needs a symmetric positive definite tangent; contact (the penalty term ε_N p ∂n/∂x) and a
@@ -14,6 +16,8 @@
 #include <deal.II/lac/petsc_vector.h>
 #include <deal.II/lac/sparse_matrix.h>
 #include <deal.II/lac/vector.h>
+
+#include "reference/sparse_direct.hpp"
 
 #include <memory>
 #include <string>
@@ -40,12 +44,22 @@ public:
   /// Solves K x = b. Returns the number of iterations (0 for the direct solver). Throws
   /// std::runtime_error if the factorisation or the iteration fails.
   int solve(const dealii::SparseMatrix<double>& K, dealii::Vector<double>& x, const dealii::Vector<double>& b);
+  /// Serial direct solver only: factorises K (kept for `solve_factorized`).
+  void factorize(const dealii::SparseMatrix<double>& K);
+  /// Serial direct solver: whether a factorisation is at hand (the last `factorize` succeeded).
+  [[nodiscard]] bool factorized() const { return m_factorized; }
+  /// Serial direct solver only: solves K x = b with the last factorisation.
+  void solve_factorized(dealii::Vector<double>& x, const dealii::Vector<double>& b) const;
+  /// Serial direct solver: its counters (factorisations, times); nullptr before the first solve.
+  [[nodiscard]] const SparseDirect::Counters* direct_counters() const {
+    return m_direct ? &m_direct->counters() : nullptr;
+  }
   /// Solves K x = b distributed over K's communicator (collective): MUMPS for Kind::direct, CG +
   /// GAMG for Kind::iterative. Same return value and errors as the serial overload.
   int solve(const dealii::PETScWrappers::MPI::SparseMatrix& K, dealii::PETScWrappers::MPI::Vector& x,
             const dealii::PETScWrappers::MPI::Vector& b);
   [[nodiscard]] Kind kind() const { return m_kind; }
-  /// "umfpack" / "mumps" (direct, serial / distributed), "petsc-cg-gamg" or "petsc-gmres-gamg".
+  /// "cholmod/umfpack" / "mumps" (direct, serial / distributed), "petsc-cg-gamg" or "petsc-gmres-gamg".
   [[nodiscard]] std::string name() const;
 
 private:
@@ -54,6 +68,9 @@ private:
   std::vector<dealii::Point<3>> m_coordinates;
   double m_tolerance;
   std::unique_ptr<Petsc> m_petsc;
+  std::unique_ptr<SparseDirect> m_direct; ///< serial direct: built from K's pattern on first use
+  std::vector<double> m_values;           ///< K's values in its pattern's order
+  bool m_factorized = false;
   bool m_distributed;
   bool m_spd;
 };

@@ -23,6 +23,17 @@ double DecoupledNeoHookean::energy(const Eigen::Matrix3d& F) const {
   return 0.5 * m_mu * (I1_bar - 3.0) + 0.25 * m_kappa * (J * J - 1.0 - 2.0 * std::log(J));
 }
 
+Eigen::Matrix3d DecoupledNeoHookean::second_piola(const Eigen::Matrix3d& F) const {
+  const double J = checked_jacobian(F);
+  const Eigen::Matrix3d C = F.transpose() * F;
+  const Eigen::Matrix3d Ci = C.inverse();
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const double I1 = C.trace();
+  const double Jm23 = std::pow(J, -2.0 / 3.0);
+  const double c1 = 0.5 * m_mu;
+  return 2.0 * c1 * Jm23 * (I - I1 / 3.0 * Ci) + 0.5 * m_kappa * (J * J - 1.0) * Ci; // as below
+}
+
 void DecoupledNeoHookean::second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const {
   const double J = checked_jacobian(F);
   const Eigen::Matrix3d C = F.transpose() * F;

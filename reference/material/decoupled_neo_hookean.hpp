@@ -22,6 +22,7 @@ public:
   ///     + κ J² C⁻¹⊗C⁻¹ − κ (J² − 1) 𝕀_{C⁻¹}
   /// (S = 2∂ψ/∂C with ∂J/∂C = J/2 C⁻¹, ∂C⁻¹/∂C = −𝕀_{C⁻¹}; Holzapfel 2000, §6.4–6.6).
   void second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const override;
+  [[nodiscard]] Eigen::Matrix3d second_piola(const Eigen::Matrix3d& F) const override;
 
 private:
   double m_mu;

@@ -8,6 +8,13 @@
 
 namespace kerf::reference {
 
+Eigen::Matrix3d HyperelasticLaw::second_piola(const Eigen::Matrix3d& F) const {
+  Eigen::Matrix3d S;
+  Tensor4 C4;
+  second_piola_and_tangent(F, S, C4);
+  return S;
+}
+
 StressTangent HyperelasticLaw::stress_and_tangent(const Eigen::Matrix3d& F) const {
   Eigen::Matrix3d S;
   Tensor4 C4;

@@ -28,6 +28,9 @@ public:
   [[nodiscard]] virtual double energy(const Eigen::Matrix3d& F) const = 0;
   /// Second Piola–Kirchhoff stress S = 2 ∂ψ/∂C [Pa] and material tangent ℂ = 2 ∂S/∂C [Pa].
   virtual void second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const = 0;
+  /// S alone, for the residual-only assemblies of the line search (the same S, bit for bit, as
+  /// `second_piola_and_tangent`, without the cost of ℂ). The default calls that function.
+  [[nodiscard]] virtual Eigen::Matrix3d second_piola(const Eigen::Matrix3d& F) const;
   /// P = F S and 𝔸 = ∂P/∂F (see `first_piola_and_tangent`).
   [[nodiscard]] StressTangent stress_and_tangent(const Eigen::Matrix3d& F) const;
 };

@@ -23,6 +23,12 @@ double NeoHookean::energy(const Eigen::Matrix3d& F) const {
   return 0.5 * m_mu * ((F.transpose() * F).trace() - 3.0) - m_mu * lnJ + 0.5 * m_lambda * lnJ * lnJ;
 }
 
+Eigen::Matrix3d NeoHookean::second_piola(const Eigen::Matrix3d& F) const {
+  const double lnJ = std::log(checked_jacobian(F));
+  const Eigen::Matrix3d Ci = (F.transpose() * F).inverse();
+  return m_mu * (Eigen::Matrix3d::Identity() - Ci) + m_lambda * lnJ * Ci; // as below
+}
+
 void NeoHookean::second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const {
   const double lnJ = std::log(checked_jacobian(F));
   const Eigen::Matrix3d Ci = (F.transpose() * F).inverse();

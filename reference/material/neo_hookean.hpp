@@ -19,6 +19,7 @@ public:
   /// S = μ (I − C⁻¹) + λ ln J C⁻¹;   ℂ = λ C⁻¹ ⊗ C⁻¹ + 2 (μ − λ ln J) 𝕀_{C⁻¹}
   /// (Bonet & Wood 2008, eqs. 6.28 and 6.40).
   void second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const override;
+  [[nodiscard]] Eigen::Matrix3d second_piola(const Eigen::Matrix3d& F) const override;
 
 private:
   double m_mu;

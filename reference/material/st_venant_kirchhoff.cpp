@@ -18,6 +18,12 @@ double StVenantKirchhoff::energy(const Eigen::Matrix3d& F) const {
   return 0.5 * m_lambda * E.trace() * E.trace() + m_mu * E.cwiseProduct(E).sum();
 }
 
+Eigen::Matrix3d StVenantKirchhoff::second_piola(const Eigen::Matrix3d& F) const {
+  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
+  const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - I);
+  return m_lambda * E.trace() * I + 2.0 * m_mu * E; // as below
+}
+
 void StVenantKirchhoff::second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const {
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - I);

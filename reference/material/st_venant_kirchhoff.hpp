@@ -18,6 +18,7 @@ public:
   [[nodiscard]] double energy(const Eigen::Matrix3d& F) const override;
   /// S = λ tr(E) I + 2μ E;   ℂ = λ I⊗I + 2μ 𝕀ˢ (𝕀ˢ the symmetric fourth-order identity).
   void second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const override;
+  [[nodiscard]] Eigen::Matrix3d second_piola(const Eigen::Matrix3d& F) const override;
 
 private:
   double m_mu;
