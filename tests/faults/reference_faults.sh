@@ -27,7 +27,7 @@ cd "$work"
 fail() { echo "FAIL: $*" >&2; exit 1; }
 sed 's/^element_size = "2.5 mm"/element_size = "5 mm"/' "$scenes/clay_pull.toml" > coarse.toml
 grep -q '^element_size = "5 mm"' coarse.toml || fail "clay_pull.toml has no element_size line to coarsen"
-samples=11
+samples=11 # evenly spaced, adaptive sampling off: the counts below are known
 
 # Every output under a final name is whole: the profile's rows have 11 columns and end in a
 # newline, the manifest is JSON, fields.pvd and every .vtu end with their closing tag.
@@ -55,7 +55,7 @@ physics() { cut -d, -f1-10 "$1"; }
 
 # 1. Uninterrupted.
 start=$(date +%s.%N)
-"$kerf" reference coarse.toml --samples $samples --no-fields -o whole > whole.log 2>&1 || { cat whole.log; fail "uninterrupted run"; }
+"$kerf" reference coarse.toml --samples $samples --adaptive 0 --no-fields -o whole > whole.log 2>&1 || { cat whole.log; fail "uninterrupted run"; }
 whole_s=$($py -c "import sys; print(max(1.0, float(sys.argv[2]) - float(sys.argv[1])))" "$start" "$(date +%s.%N)")
 [ "$(wc -l < whole/profile.csv)" -eq $((samples + 1)) ] || fail "uninterrupted profile has $(wc -l < whole/profile.csv) lines"
 check_whole whole
@@ -79,7 +79,7 @@ wait_for_sample() {
   done
 }
 for attempt in $(seq 1 6); do
-  "$kerf" reference coarse.toml --samples $samples -o killed --resume > "killed.$attempt.log" 2>&1 &
+  "$kerf" reference coarse.toml --samples $samples --adaptive 0 -o killed --resume > "killed.$attempt.log" 2>&1 &
   pid=$!
   if [ "$attempt" -lt 6 ]; then
     # Attempts 1-2: once the solve has started (its first sample printed), a kill time uniform
@@ -126,7 +126,7 @@ for limit in "64 fields" "12 no-fields"; do
   [ "$2" = "no-fields" ] && flags=(--no-fields)
   dir="full_$kb"
   set +e
-  ( trap '' XFSZ; ulimit -f "$kb"; exec "$kerf" reference coarse.toml --samples $samples "${flags[@]}" -o "$dir" ) > "$dir.log" 2>&1
+  ( trap '' XFSZ; ulimit -f "$kb"; exec "$kerf" reference coarse.toml --samples $samples --adaptive 0 "${flags[@]}" -o "$dir" ) > "$dir.log" 2>&1
   rc=$?
   set -e
   [ "$rc" -ne 0 ] || { cat "$dir.log"; fail "a run past the $kb kB file-size limit succeeded"; }
@@ -134,7 +134,7 @@ for limit in "64 fields" "12 no-fields"; do
   grep -Eiq 'writ|disk|space|too large|input/output' "$dir.log" || { cat "$dir.log"; fail "no message about the failed write"; }
   check_whole "$dir"
   echo "full disk at $kb kB ($2): exit $rc: $(grep -m1 -A12 'kerf: error' "$dir.log" | grep -v '^#' | tr -s '\n ' ' ' | cut -c1-160)"
-  "$kerf" reference coarse.toml --samples $samples "${flags[@]}" -o "$dir" --resume > "$dir.resume.log" 2>&1 \
+  "$kerf" reference coarse.toml --samples $samples --adaptive 0 "${flags[@]}" -o "$dir" --resume > "$dir.resume.log" 2>&1 \
     || { cat "$dir.resume.log"; fail "resume after the full disk"; }
   check_whole "$dir"
   diff <(physics whole/profile.csv) <(physics "$dir/profile.csv") || fail "the profile after a full disk and --resume differs"
@@ -148,7 +148,7 @@ done
 ckpt10=$(stat -c %s whole/checkpoint.bin)
 limit=$((ckpt10 - 256))
 set +e
-$py - "$limit" "$kerf" reference coarse.toml --samples $samples --no-fields -o full_ckpt > full_ckpt.log 2>&1 <<'PY'
+$py - "$limit" "$kerf" reference coarse.toml --samples $samples --adaptive 0 --no-fields -o full_ckpt > full_ckpt.log 2>&1 <<'PY'
 import os, resource, signal, sys
 limit = int(sys.argv[1])
 signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
@@ -162,7 +162,7 @@ grep -q 'checkpoint' full_ckpt.log || { cat full_ckpt.log; fail "no message nami
 check_whole full_ckpt
 [ -e full_ckpt/checkpoint.bin ] && [ "$(stat -c %s full_ckpt/checkpoint.bin)" -le "$limit" ] \
   || fail "the checkpoint after sample 5 is not on disk whole"
-"$kerf" reference coarse.toml --samples $samples --no-fields -o full_ckpt --resume > full_ckpt.resume.log 2>&1 \
+"$kerf" reference coarse.toml --samples $samples --adaptive 0 --no-fields -o full_ckpt --resume > full_ckpt.resume.log 2>&1 \
   || { cat full_ckpt.resume.log; fail "resume after the disk filled between checkpoints"; }
 grep -q "resuming after sample 5/$samples" full_ckpt.resume.log || { cat full_ckpt.resume.log; fail "did not resume from the checkpoint after sample 5"; }
 check_whole full_ckpt
@@ -175,7 +175,7 @@ echo "  then --resume (resuming after sample 5/$samples): the profile equals the
 sed 's/^to = \["20 mm", "0 mm", "30 mm"\]/to = ["20 mm", "0 mm", "2 m"]/' coarse.toml > absurd.toml
 grep -q '"2 m"' absurd.toml || fail "clay_pull.toml has no pull target to exaggerate"
 set +e
-"$kerf" reference absurd.toml --samples 2 -o absurd > absurd.log 2>&1
+"$kerf" reference absurd.toml --samples 2 --adaptive 0 -o absurd > absurd.log 2>&1
 rc=$?
 set -e
 [ "$rc" -lt 128 ] || { cat absurd.log; fail "the absurd increment crashed the run (signal $((rc - 128)))"; }
