@@ -4,7 +4,7 @@
 # and run again after each kill the way a user would (`kerf reference --resume`, `kerf study`
 # into the same folder) until it finishes; its result must equal an uninterrupted run's.
 #   reference: potato_wedge_cut with cohesive fracture (rupture, cutting, deformation-2) on a 5 mm
-#              mesh, 16 samples (checkpoints after samples 5, 10, 15): the profile, every column
+#              mesh, 16 samples, adaptive sampling off (checkpoints after samples 5, 10, 15): the profile, every column
 #              but cost_s, to the last printed digit (the solver is deterministic);
 #   study:     one scene (potato_wedge_cut), the fracture model, the reference at 6 samples on the
 #              coarse level -1: the table study.csv, every column but the compute costs.
@@ -44,7 +44,7 @@ run() {
     reference)
       local resume=(--resume)
       [ -n "$first" ] || [ ! -e "$dir/checkpoint.bin" ] && resume=()
-      "$kerf" reference potato_wedge_cut --fracture on --element-size "5 mm" --samples 16 --no-fields -o "$dir" \
+      "$kerf" reference potato_wedge_cut --fracture on --element-size "5 mm" --samples 16 --adaptive 0 --no-fields -o "$dir" \
         "${resume[@]}" >> "$dir.log" 2>&1 &
       ;;
     study) "$kerf" study tiny.toml -j 1 -o "$dir" >> "$dir.log" 2>&1 & ;;
