@@ -142,6 +142,26 @@ def plot_profiles(stem, runs, axis, reference=None, band_source="", time_panel=F
                 for k in range(len(xs)):
                     data.append((panel, name, xs[k], force[k], low[k] if low else None, high[k] if high else None))
             shaded = True
+    # The ground truth sets the scale: a model whose force runs beyond four times the reference's
+    # extent (its band included) leaves the axes, and is named, with its largest force, at the top;
+    # its whole curve stays in the data file.
+    off_scale = []
+    if reference:
+        ref_values = [v for p_, name_, x_, y_, lo, hi in data if name_.startswith(reference[0])
+                      for v in (y_, lo, hi) if v is not None and not math.isnan(v)]
+        if ref_values:
+            top = 4.0 * max(max(abs(v) for v in ref_values), 1e-12)
+            peaks = {}
+            for p_, name_, x_, y_, lo, hi in data:
+                if not name_.startswith(reference[0]):
+                    peaks[name_] = max(peaks.get(name_, 0.0), abs(y_))
+            off_scale = sorted((name_, peak) for name_, peak in peaks.items() if peak > top)
+            if off_scale:
+                bottom = min(min(ref_values), 0.0)
+                for ax in axes.values():
+                    ax.set_ylim(bottom - 0.05 * (top - bottom), top)
+                axes["travel"].text(0.99, 0.99, "off scale: " + ", ".join(f"{n_} (up to {pk:.3g} N)" for n_, pk in off_scale),
+                                    transform=axes["travel"].transAxes, ha="right", va="top", fontsize=6, color="0.3")
     for panel, ax in axes.items():
         ax.set_xlabel(dict(panels)[panel])
         ax.set_ylabel("resisting force [N]")
