@@ -40,7 +40,7 @@ void add_crack_path_grading(const Scene& scene, double nominal, double scale, st
     if (top == g.parameters.end() || declared.count("depth") == 0) return;
     double lowest = std::numeric_limits<double>::infinity();
     for (const ToolState& st : sample(t.trajectory).samples) lowest = std::min(lowest, st.position.z());
-    refine_depth = std::clamp(top->second - lowest + zone.length() * scale, size, top->second);
+    refine_depth = std::min(std::max(top->second - lowest + zone.length() * scale, size), top->second);
   }
   p["cut_element_size"] = size;
   p["cut_far_size"] = h;
