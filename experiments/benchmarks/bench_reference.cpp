@@ -94,14 +94,7 @@ void cook(benchmark::State& state) {
   double tip = 0.0, its = 0.0;
   std::size_t dofs = 0;
   for (auto _ : state) {
-    FiniteStrainProblem p;
-    p.mesh = test::cook_membrane(n);
-    const double mu = 422.5e3, nu = 0.3;
-    p.materials.push_back({"body", LawKind::decoupled_neo_hookean, 2.0 * mu * (1.0 + nu), nu});
-    p.displacement_boundaries.push_back({"xmin", DisplacementBoundary::Kind::bonded, {}, {}});
-    p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::sliding, {}, {}});
-    p.displacement_boundaries.push_back({"zmax", DisplacementBoundary::Kind::sliding, {}, {}});
-    p.tractions.push_back({"xmax", Eigen::Vector3d(0.0, 1.0, 0.0)});
+    const FiniteStrainProblem p = test::cook_membrane_problem(test::cook_membrane(n));
     SolverSettings settings;
     settings.degree = 2;
     FiniteStrainSolver solver(p, settings);

@@ -20,6 +20,7 @@
 #include "meshes/gmsh_io.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "reference/finite_strain_solver.hpp"
+#include "tests/reference/reference_test_meshes.hpp"
 
 #include <sys/resource.h>
 
@@ -164,13 +165,7 @@ void write_feb(const TetMesh& mesh, const std::filesystem::path& file) {
 int solve(const std::filesystem::path& msh, bool full_newton) {
   const double cpu0 = cpu_seconds();
   const auto wall0 = std::chrono::steady_clock::now();
-  FiniteStrainProblem p;
-  p.mesh = read_msh(msh);
-  p.materials.push_back({"body", LawKind::decoupled_neo_hookean, 2.0 * k_mu * (1.0 + k_nu), k_nu});
-  p.displacement_boundaries.push_back({"xmin", DisplacementBoundary::Kind::bonded, {}, {}});
-  p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::sliding, {}, {}});
-  p.displacement_boundaries.push_back({"zmax", DisplacementBoundary::Kind::sliding, {}, {}});
-  p.tractions.push_back({"xmax", Eigen::Vector3d(0.0, 1.0, 0.0)});
+  const FiniteStrainProblem p = test::cook_membrane_problem(read_msh(msh));
   SolverSettings settings;
   settings.degree = 2;
   settings.linear_solver = LinearSolverChoice::direct; // FEBio's skyline is direct too, at every size

@@ -89,6 +89,13 @@ ForceProfile read_profile_csv(const std::filesystem::path& csv) {
   return profile;
 }
 
+std::vector<const ProfileRow*> rows_of_tool(const ForceProfile& profile, const std::string& tool) {
+  std::vector<const ProfileRow*> rows;
+  for (const ProfileRow& r : profile.rows)
+    if (r.tool == tool) rows.push_back(&r);
+  return rows;
+}
+
 double tool_work(const ForceProfile& profile, const std::string& tool, std::size_t first, std::size_t last) {
   double work = 0.0;
   const ProfileRow* previous = nullptr;

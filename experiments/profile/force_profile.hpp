@@ -39,6 +39,9 @@ void write_profile_csv(const ForceProfile& profile, const std::filesystem::path&
 /// wrong header, a wrong column count, a non-numeric or non-finite number, or an unknown mode.
 ForceProfile read_profile_csv(const std::filesystem::path& csv);
 
+/// The rows of the tool named `tool`, in profile order (pointers into `profile`).
+std::vector<const ProfileRow*> rows_of_tool(const ForceProfile& profile, const std::string& tool);
+
 /// Work done by the tool named `tool` on the body over rows [first, last] (indices into that
 /// tool's rows), by the trapezoidal rule: W = sum ½ (g_k + g_{k-1}) . (p_k - p_{k-1}), where
 /// g = -force is the force the tool applies to the body [J].

@@ -12,6 +12,13 @@
 
 namespace kerf {
 
+double blade_reach(const Tool& blade) {
+  double reach = -std::numeric_limits<double>::infinity();
+  for (const ToolState& st : sample(blade.trajectory).samples)
+    reach = std::max(reach, st.position.dot(blade.blade.cutting_direction));
+  return reach;
+}
+
 CohesiveZone scene_cohesive_zone(const Scene& scene) {
   CohesiveZone z;
   const Material& m = scene.material;
@@ -71,13 +78,8 @@ CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem&
   const Tool* blade = nullptr;
   for (const Tool& t : scene.tools)
     if (t.kind == Tool::Kind::blade) blade = &t;
-  double lowest = -std::numeric_limits<double>::infinity(); // along the cutting direction c: how far the edge reaches
-  Eigen::Vector3d c = Eigen::Vector3d::UnitZ();
-  if (blade != nullptr) {
-    c = blade->blade.cutting_direction;
-    lowest = -std::numeric_limits<double>::infinity();
-    for (const ToolState& st : sample(blade->trajectory).samples) lowest = std::max(lowest, st.position.dot(c));
-  }
+  const Eigen::Vector3d c = blade != nullptr ? blade->blade.cutting_direction : Eigen::Vector3d::UnitZ();
+  const double reach = blade != nullptr ? blade_reach(*blade) : 0.0; // along c
   // The representative size of the triangles there: the side of the equilateral triangle of their
   // mean area, h = (4 Ā / √3)^½ (the surface analogue of Celik et al. 2008's h = (V/N)^⅓).
   double area = 0.0;
@@ -87,7 +89,7 @@ CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem&
       Eigen::Vector3d v[3];
       for (int j = 0; j < 3; ++j) v[j] = split.mesh.nodes.row(split.plus_faces(f, j)).transpose();
       const Eigen::Vector3d centroid = (v[0] + v[1] + v[2]) / 3.0;
-      if (pass == 0 && blade != nullptr && centroid.dot(c) > lowest + info.zone_length) continue; // beyond the blade's reach
+      if (pass == 0 && blade != nullptr && centroid.dot(c) > reach + info.zone_length) continue; // beyond the blade's reach
       area += 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).norm();
       ++count;
     }

@@ -37,6 +37,10 @@ struct CohesiveZone {
   double length() const { return rice > wedge ? rice : wedge; }
 };
 
+/// How far `blade`'s edge reaches along its cutting direction c over its trajectory,
+/// max_k p_k · c [m] (p_k the edge midpoint's sampled positions).
+double blade_reach(const Tool& blade);
+
 /// The zone of `scene`'s cohesive law and blade; both 0 when the scene gives no σ_c or J_c.
 CohesiveZone scene_cohesive_zone(const Scene& scene);
 

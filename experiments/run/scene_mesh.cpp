@@ -1,12 +1,10 @@
 #include "experiments/run/scene_mesh.hpp"
 
 #include "experiments/run/reference_fracture.hpp"
-#include "experiments/trajectory/trajectory.hpp"
 #include "meshes/gmsh_io.hpp"
 #include "meshes/mesh_error.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -38,8 +36,7 @@ void add_crack_path_grading(const Scene& scene, double nominal, double scale, st
     if (t.blade.cutting_direction.z() > -0.999) return; // not a downward cut: the box grading does not apply
     const auto top = g.parameters.find("depth");
     if (top == g.parameters.end() || declared.count("depth") == 0) return;
-    double lowest = std::numeric_limits<double>::infinity();
-    for (const ToolState& st : sample(t.trajectory).samples) lowest = std::min(lowest, st.position.z());
+    const double lowest = -blade_reach(t); // the cutting direction is −z: the edge's lowest z
     refine_depth = std::min(std::max(top->second - lowest + zone.length() * scale, size), top->second);
   }
   p["cut_element_size"] = size;

@@ -8,13 +8,6 @@ namespace kerf {
 
 namespace {
 
-std::vector<const ProfileRow*> rows_of(const ForceProfile& p, const std::string& tool) {
-  std::vector<const ProfileRow*> rows;
-  for (const ProfileRow& r : p.rows)
-    if (r.tool == tool) rows.push_back(&r);
-  return rows;
-}
-
 std::optional<double> rupture_travel(const std::vector<const ProfileRow*>& rows) {
   for (const ProfileRow* r : rows)
     if (r->mode == InteractionMode::rupture) return (r->position - rows.front()->position).norm();
@@ -25,8 +18,8 @@ std::optional<double> rupture_travel(const std::vector<const ProfileRow*>& rows)
 
 ProfileMetrics compare_profiles(const ForceProfile& model, const ForceProfile& reference, const std::string& tool,
                                 const std::optional<SteadyCuttingExpectation>& cutting) {
-  const auto m = rows_of(model, tool);
-  const auto r = rows_of(reference, tool);
+  const auto m = rows_of_tool(model, tool);
+  const auto r = rows_of_tool(reference, tool);
   if (m.empty() || m.size() != r.size())
     throw std::invalid_argument("compare profiles: tool " + tool + " has " + std::to_string(m.size()) +
                                 " model samples and " + std::to_string(r.size()) + " reference samples");

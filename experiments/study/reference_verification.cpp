@@ -12,13 +12,6 @@ namespace kerf {
 
 namespace {
 
-std::vector<const ProfileRow*> rows_of(const ForceProfile& p, const std::string& tool) {
-  std::vector<const ProfileRow*> rows;
-  for (const ProfileRow& r : p.rows)
-    if (r.tool == tool) rows.push_back(&r);
-  return rows;
-}
-
 /// Finest first.
 std::vector<const ReferenceLevel*> by_element_size(const std::vector<ReferenceLevel>& levels) {
   std::vector<const ReferenceLevel*> sorted;
@@ -77,7 +70,7 @@ std::optional<ReferenceVerification> verify_reference(const std::vector<Referenc
   for (int k = 0; k < 3; ++k) {
     v.levels[k] = sorted[k]->level;
     v.element_sizes[k] = sorted[k]->element_size;
-    const auto rows = rows_of(common[k], tool);
+    const auto rows = rows_of_tool(common[k], tool);
     if (rows.size() < 2)
       throw std::invalid_argument("reference verification: the three finest levels (L" + std::to_string(sorted[0]->level) + ", L" +
                                   std::to_string(sorted[1]->level) + ", L" + std::to_string(sorted[2]->level) + ") share " +
@@ -104,9 +97,9 @@ ReferenceBand reference_band(const std::vector<ReferenceLevel>& levels, const st
   if (levels.empty()) return band;
   const auto sorted = by_element_size(levels);
   const auto resisting = [&](const ProfileRow* r) { return -r->force.dot(direction); };
-  const auto fine = rows_of(sorted[0]->profile, tool);
+  const auto fine = rows_of_tool(sorted[0]->profile, tool);
   std::vector<std::vector<const ProfileRow*>> others;
-  for (std::size_t k = 1; k < sorted.size(); ++k) others.push_back(rows_of(sorted[k]->profile, tool));
+  for (std::size_t k = 1; k < sorted.size(); ++k) others.push_back(rows_of_tool(sorted[k]->profile, tool));
   band.from_gci = verification && verification->rms.usable() && sorted.size() >= 2;
   for (const ProfileRow* r : fine) {
     const double f1 = resisting(r);

@@ -31,7 +31,8 @@ Eigen::Matrix3d DecoupledNeoHookean::second_piola(const Eigen::Matrix3d& F) cons
   const double I1 = C.trace();
   const double Jm23 = std::pow(J, -2.0 / 3.0);
   const double c1 = 0.5 * m_mu;
-  return 2.0 * c1 * Jm23 * (I - I1 / 3.0 * Ci) + 0.5 * m_kappa * (J * J - 1.0) * Ci; // as below
+  // S = 2c₁ J^(−2/3) (I − I₁/3 C⁻¹) + κ/2 (J² − 1) C⁻¹
+  return 2.0 * c1 * Jm23 * (I - I1 / 3.0 * Ci) + 0.5 * m_kappa * (J * J - 1.0) * Ci;
 }
 
 void DecoupledNeoHookean::second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const {
@@ -42,8 +43,7 @@ void DecoupledNeoHookean::second_piola_and_tangent(const Eigen::Matrix3d& F, Eig
   const double I1 = C.trace();
   const double Jm23 = std::pow(J, -2.0 / 3.0);
   const double c1 = 0.5 * m_mu;
-  // S = 2c₁ J^(−2/3) (I − I₁/3 C⁻¹) + κ/2 (J² − 1) C⁻¹
-  S = 2.0 * c1 * Jm23 * (I - I1 / 3.0 * Ci) + 0.5 * m_kappa * (J * J - 1.0) * Ci;
+  S = second_piola(F);
   const Tensor4 Ic = inverse_derivative_tensor(Ci);
   const Tensor4 CiCi = dyadic(Ci, Ci);
   // ℂ_iso = 4c₁ J^(−2/3) [ I₁/3 𝕀 + I₁/9 C⁻¹⊗C⁻¹ − 1/3 (I⊗C⁻¹ + C⁻¹⊗I) ]

@@ -26,14 +26,14 @@ double NeoHookean::energy(const Eigen::Matrix3d& F) const {
 Eigen::Matrix3d NeoHookean::second_piola(const Eigen::Matrix3d& F) const {
   const double lnJ = std::log(checked_jacobian(F));
   const Eigen::Matrix3d Ci = (F.transpose() * F).inverse();
-  return m_mu * (Eigen::Matrix3d::Identity() - Ci) + m_lambda * lnJ * Ci; // as below
+  // S = μ (I − C⁻¹) + λ ln J C⁻¹
+  return m_mu * (Eigen::Matrix3d::Identity() - Ci) + m_lambda * lnJ * Ci;
 }
 
 void NeoHookean::second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const {
   const double lnJ = std::log(checked_jacobian(F));
   const Eigen::Matrix3d Ci = (F.transpose() * F).inverse();
-  // S = μ (I − C⁻¹) + λ ln J C⁻¹
-  S = m_mu * (Eigen::Matrix3d::Identity() - Ci) + m_lambda * lnJ * Ci;
+  S = second_piola(F);
   // ℂ = λ C⁻¹ ⊗ C⁻¹ + 2 (μ − λ ln J) 𝕀_{C⁻¹}
   C4 = m_lambda * dyadic(Ci, Ci) + 2.0 * (m_mu - m_lambda * lnJ) * inverse_derivative_tensor(Ci);
 }

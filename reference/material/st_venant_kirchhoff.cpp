@@ -21,14 +21,13 @@ double StVenantKirchhoff::energy(const Eigen::Matrix3d& F) const {
 Eigen::Matrix3d StVenantKirchhoff::second_piola(const Eigen::Matrix3d& F) const {
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - I);
-  return m_lambda * E.trace() * I + 2.0 * m_mu * E; // as below
+  // S = λ tr(E) I + 2μ E
+  return m_lambda * E.trace() * I + 2.0 * m_mu * E;
 }
 
 void StVenantKirchhoff::second_piola_and_tangent(const Eigen::Matrix3d& F, Eigen::Matrix3d& S, Tensor4& C4) const {
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  const Eigen::Matrix3d E = 0.5 * (F.transpose() * F - I);
-  // S = λ tr(E) I + 2μ E
-  S = m_lambda * E.trace() * I + 2.0 * m_mu * E;
+  S = second_piola(F);
   // ℂ = λ I⊗I + 2μ 𝕀ˢ, 𝕀ˢ_IJKL = ½ (δ_IK δ_JL + δ_IL δ_JK) (= 𝕀_{C⁻¹} at C = I)
   C4 = m_lambda * dyadic(I, I) + 2.0 * m_mu * inverse_derivative_tensor(I);
 }

@@ -139,4 +139,18 @@ void add_interior_face_group(TetMesh& mesh, const std::string& name, const std::
   mesh.surface_groups.push_back(std::move(group));
 }
 
+FiniteStrainProblem cook_membrane_problem(TetMesh mesh, bool plane_strain) {
+  FiniteStrainProblem p;
+  p.mesh = std::move(mesh);
+  const double mu = 422.5e3, nu = 0.3; // the gallery's parameters.prm
+  p.materials.push_back({"body", LawKind::decoupled_neo_hookean, 2.0 * mu * (1.0 + nu), nu});
+  p.displacement_boundaries.push_back({"xmin", DisplacementBoundary::Kind::bonded, {}, {}});
+  if (plane_strain) {
+    p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::sliding, {}, {}});
+    p.displacement_boundaries.push_back({"zmax", DisplacementBoundary::Kind::sliding, {}, {}});
+  }
+  p.tractions.push_back({"xmax", Eigen::Vector3d(0.0, 1.0, 0.0)});
+  return p;
+}
+
 } // namespace kerf::reference::test

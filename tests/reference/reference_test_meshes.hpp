@@ -3,6 +3,7 @@
 // named, the MacNeal–Harder 3-D patch, and Cook's membrane.
 
 #include "meshes/tet_mesh.hpp"
+#include "reference/finite_strain_solver.hpp"
 
 #include <functional>
 #include <string>
@@ -27,6 +28,12 @@ TetMesh macneal_harder_patch();
 /// 1 mm thick (z in [-0.5, 0.5] mm), n by n by 1 cells, each split into 6 tetrahedra. Surface
 /// groups `xmin` (clamped), `xmax` (loaded), `zmin`, `zmax`. Units: metres.
 TetMesh cook_membrane(int n);
+
+/// Cook's membrane problem of the code gallery on `mesh` (cook_membrane(n), or a gmsh mesh with the
+/// same surface groups): its decoupled neo-Hookean energy (μ = 422.5 kPa, ν = 0.3), `xmin`
+/// clamped, the dead shear load (0, 1, 0) on `xmax`, and with `plane_strain` the faces `zmin` and
+/// `zmax` sliding.
+FiniteStrainProblem cook_membrane_problem(TetMesh mesh, bool plane_strain = true);
 
 /// Adds the surface group `name`: the interior faces (shared by two tetrahedra) whose three nodes
 /// all satisfy `on_surface`, e.g. a grid plane of a box mesh to be split into a crack path.

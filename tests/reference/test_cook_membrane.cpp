@@ -14,16 +14,7 @@ namespace kerf::reference {
 namespace {
 
 double cook_tip_displacement(int n, int degree, bool plane_strain, const Eigen::Vector3d& tip_point) {
-  FiniteStrainProblem p;
-  p.mesh = test::cook_membrane(n);
-  const double mu = 422.5e3, nu = 0.3;
-  p.materials.push_back({"body", LawKind::decoupled_neo_hookean, 2.0 * mu * (1.0 + nu), nu});
-  p.displacement_boundaries.push_back({"xmin", DisplacementBoundary::Kind::bonded, {}, {}});
-  if (plane_strain) {
-    p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::sliding, {}, {}});
-    p.displacement_boundaries.push_back({"zmax", DisplacementBoundary::Kind::sliding, {}, {}});
-  }
-  p.tractions.push_back({"xmax", Eigen::Vector3d(0.0, 1.0, 0.0)});
+  const FiniteStrainProblem p = test::cook_membrane_problem(test::cook_membrane(n), plane_strain);
   SolverSettings settings;
   settings.degree = degree;
   FiniteStrainSolver solver(p, settings);
