@@ -1,5 +1,5 @@
 #pragma once
-// The fuzz harnesses: one per input format kerf parses (issue 10). Each takes the raw bytes of
+// The fuzz harnesses: one per input format kerf parses (docs/reliability.md). Each takes the raw bytes of
 // one input and returns normally when the parser either accepted it (and what it returned
 // satisfies the format's documented invariants) or rejected it with the documented error type.
 // Anything else escapes: an undocumented exception (libFuzzer aborts on it and saves the input),

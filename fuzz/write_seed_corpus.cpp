@@ -1,5 +1,5 @@
-// Writes the seed corpora of the fuzz targets from the repository's own files (issue 10: "seed
-// corpora from the real files in the repo"), into the build tree, so nothing is duplicated in git:
+// Writes the seed corpora of the fuzz targets from the repository's own files (real inputs are the
+// best seeds), into the build tree, so nothing is duplicated in git:
 //   seeds/scene/           the scene files given on the command line, copied
 //   seeds/quantity/        every string value of those scenes, prefixed with the Dimension byte
 //                          under which parse_quantity accepts it (0 when none does)

@@ -1,7 +1,7 @@
-// Costs of the finite-strain reference (issue 3): time per Newton iteration and per load step
+// Costs of the finite-strain reference (docs/reference.md): time per Newton iteration and per load step
 // against the number of DOFs (P1 and P2 at three sizes with equal DOF counts, UMFPACK against
 // PETSc CG + GAMG), peak memory; Cook's membrane in 10 load steps at ~4.6k and ~16.7k DOFs (to
-// compare with FEBio 4.11's 0.72 s and ~6 s quoted in issue 3); the deformation phase of
+// compare with FEBio 4.11 on the same problem: experiments/benchmarks/febio_cook.sh); the deformation phase of
 // potato_rect_cut at the scene's default resolution (the blade pressed 1.5 mm in).
 //
 //   ./build/experiments/benchmarks/bench_reference

@@ -35,8 +35,8 @@ struct BlockMaterial {
 /// The clay scenes (experiments/scenes/clay_pull.toml): E = 0.5 MPa, ν = 0.45, ρ = 1700 kg/m³,
 /// η = 10 Pa s, 2.5 mm cells.
 constexpr BlockMaterial clay{0.5e6, 0.45, 1700.0, 10.0, 2.5e-3};
-/// The peer of issue 5 (Vega FEM's 28-spring cubes): 2 mm cells, E = 50 kPa; ν = 0.45 and
-/// ρ = 1000 kg/m³ are our choice (the issue gives neither), η = 1 Pa s keeps the clay's
+/// The peer setting (Vega FEM's 28-spring cubes): 2 mm cells, E = 50 kPa; ν = 0.45 and
+/// ρ = 1000 kg/m³ are our choice (the peer setting gives neither), η = 1 Pa s keeps the clay's
 /// retardation time τ = η/E = 20 µs.
 constexpr BlockMaterial peer{50e3, 0.45, 1000.0, 1.0, 2e-3};
 

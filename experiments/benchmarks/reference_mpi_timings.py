@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Serial vs `mpirun -np 2` timings of the finite-strain reference (issue 3, docs/reference.md).
+"""Serial vs `mpirun -np 2` timings of the finite-strain reference (docs/reference.md).
 
 Runs `kerf reference SCENE --samples N --no-fields` for P1/P2, a few global refinements, the
 direct and the iterative linear solver, on 1 and 2 MPI processes, and prints a Markdown table

@@ -1,5 +1,5 @@
 #pragma once
-// Calibration (issue 7): a fast model's free parameters (free_parameters.hpp) fitted to a target
+// Calibration (docs/studies.md): a fast model's free parameters (free_parameters.hpp) fitted to a target
 // force profile — the finite-element reference, a measured profile, or one the model itself
 // generated — by minimising the normalised RMS force error (profile_metrics.hpp) with the
 // Nelder–Mead simplex (nelder_mead.hpp, which says why that method) over the logarithms of the

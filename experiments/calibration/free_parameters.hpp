@@ -1,5 +1,5 @@
 #pragma once
-// The free parameters of each fast model that calibration fits (issue 7, "Calibration"): where each
+// The free parameters of each fast model that calibration fits (docs/studies.md): where each
 // lives in a Scene, and the key and unit it is written with in a parameter file that a scene
 // includes (docs/scenes.md, "Including parameter files").
 

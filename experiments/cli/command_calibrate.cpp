@@ -1,7 +1,7 @@
 // kerf calibrate SCENE --model M [--trajectory SESSION] [--target PROFILE.csv] [-o params.toml]:
 // fit a fast model's free parameters to the reference (or to any target profile) on a calibration
 // trajectory, validate on held-out trajectories, and write a parameter file a scene includes
-// (issue 7, "Calibration"; docs/studies.md).
+// (docs/studies.md, "Calibration").
 
 #include "experiments/calibration/calibration.hpp"
 #include "experiments/cli/commands.hpp"

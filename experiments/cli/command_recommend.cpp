@@ -1,6 +1,6 @@
 // kerf recommend SCENE --max-error 10% --rate 1000 [--tables DIR]: the cheapest model that the
 // measured study tables say meets the error budget at the servo rate, with the evidence row; "none"
-// and why when nothing does (issue 7, "Model selection").
+// and why when nothing does (docs/studies.md, `kerf recommend`).
 
 #include "experiments/cli/commands.hpp"
 #include "experiments/study/model_recommendation.hpp"

@@ -2,7 +2,7 @@
 // [--element-size H] [-o DIR] [--resume] [--no-fields] [--solver auto|direct|iterative] [--np N]
 // [--fracture auto|on|off] [--adaptive F] [--min-travel MM] [--cohesive-viscous-time TAU] [--dynamic] [--no-damping]
 // [--interface-energy-tolerance REL]: the finite-strain reference along the
-// scene's trajectory (issue 3),
+// scene's trajectory (docs/reference.md),
 // written as profile.csv + manifest.json (+ fields.pvd), with a progress line per sample and
 // checkpoints to resume from; with --levels, a mesh convergence study over L refinements. `--np N`
 // re-launches the same command under `mpirun -np N` (as `mpirun -np N kerf reference …` does

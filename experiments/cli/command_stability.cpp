@@ -1,5 +1,5 @@
 // kerf stability SCENE --model M [-o DIR] [--doc FILE]: the model pushed one axis at a time past its
-// nominal scene (issue 7, "Stability at the extremes"), every run classified, written as a table
+// nominal scene (docs/studies.md, `kerf stability`), every run classified, written as a table
 // and a map (PNG, PDF); with --doc, the model's edge is written into that Markdown page.
 
 #include "experiments/cli/commands.hpp"

@@ -1,5 +1,5 @@
 // kerf study STUDY [-o DIR] [--results-doc FILE] [--jobs N]: scenes x models x resolutions, scored
-// against the reference, as tables (Markdown, LaTeX, CSV) and plots (issue 7). Independent runs go
+// against the reference, as tables (Markdown, LaTeX, CSV) and plots (docs/studies.md). Independent runs go
 // on N threads; under `mpirun -np R` they are spread over the R ranks too, and rank 0 writes.
 
 #include "experiments/cli/commands.hpp"

@@ -1,5 +1,5 @@
 #pragma once
-// Mesh convergence of the reference (issue 3): the same scene run at successive global
+// Mesh convergence of the reference (docs/reference.md): the same scene run at successive global
 // refinements of its mesh (each halves the element size h; nested meshes, so every level solves
 // the same boundary-value problem), the force–displacement curves compared sample by sample, and
 // the observed order of convergence

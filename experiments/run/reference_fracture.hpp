@@ -73,7 +73,7 @@ struct CrackPathInfo {
 CrackPathInfo add_crack_path(const Scene& scene, reference::FiniteStrainProblem& problem, ReferenceFracture mode,
                              int refinements, double viscous_time = 0.0);
 
-/// The energy bookkeeping of a run (issue 4): external work by the tools on the body
+/// The energy bookkeeping of a run (docs/cohesive-fracture.md): external work by the tools on the body
 /// (trapezoid rule over the solved samples, W = Σ ½ (F_k + F_{k−1})·(x_k − x_{k−1}) with F the force
 /// of the tool on the body), stored elastic energy ∫ψ dV, interface energy, the penalty energy of
 /// the tool contact, cohesive dissipation, viscous dissipation, friction dissipation (0: the

@@ -1,5 +1,5 @@
 #pragma once
-// The scene-level reference run (issue 3): the scene mapped to a finite-strain problem (materials
+// The scene-level reference run (docs/reference.md): the scene mapped to a finite-strain problem (materials
 // per region, supports, the tool as a rigid body), the chosen trajectory samples solved along a
 // load path with cut-back, and the result written as profile.csv + manifest.json, fields.pvd with
 // a .vtu per solved sample, a progress line per sample, and checkpoints to resume from.
@@ -66,7 +66,7 @@ struct ReferenceRunSettings {
   /// (A the crack path's area) is rejected and re-solved in halves. Both 0: off.
   double interface_error_relative = 0.005;
   double interface_error_floor = 1e-5;
-  /// Fault injection for tests (issue 10): passed to the solver as
+  /// Fault injection for tests (docs/reliability.md): passed to the solver as
   /// reference::SolverSettings::residual_fault (a NaN in the chosen Newton iterations' residual).
   std::function<bool(const reference::LoadState& load, int newton_iteration)> residual_fault;
 };

@@ -21,7 +21,7 @@ namespace kerf {
 namespace {
 
 /// The spring model as `kerf run` steps it, keeping what the .vtu series of the embedded fine
-/// mesh needs (issue 5: "the embedded mesh is what is written to .vtu for viewing"): every
+/// mesh needs (the embedded fine mesh, not the network, is what the .vtu series shows): every
 /// `interval` [s] of simulated time the network's node positions and cell corners (which a tear
 /// re-points), copied into frames allocated at construction, so `step` allocates nothing and
 /// the cost the profile records stays the model's own plus one copy per frame. Not for the

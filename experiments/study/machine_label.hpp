@@ -1,6 +1,6 @@
 #pragma once
 // The machine a study's costs were measured on, for the table's caption: the CPU model and the
-// number of cores (issue 23: "costs ... labelled with the machine (CPU model, cores)").
+// number of cores (a cost means nothing without the machine it was measured on).
 
 #include <string>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Model selection (issue 7, "Model selection"): from the measured study tables, the cheapest
+// Model selection (docs/studies.md, `kerf recommend`): from the measured study tables, the cheapest
 // model that keeps a scene's force error within a budget at a servo rate — with the table row
 // that shows it — or "none" and why.
 

@@ -1,5 +1,5 @@
 #pragma once
-// A fast model at another resolution (issue 23, "the trade is one point per model"): a study file's
+// A fast model at another resolution (one point of its speed/accuracy trade each): a study file's
 // `[models.NAME] resolutions = [...]` runs the model once per value, each a point of its
 // speed/accuracy curve. The knob of each model, set on the scene the model is built from (its
 // builder reads it there; experiments/run/*_builder.cpp):

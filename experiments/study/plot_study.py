@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plots of a kerf study (issue 7), from kerf's own CSV files, with matplotlib.
+"""Plots of a kerf study (docs/studies.md), from kerf's own CSV files, with matplotlib.
 
   plot_study.py profiles OUT_STEM [LABEL=PROFILE.csv ...] [--run LABEL PROFILE.csv ...] [--axis x|y|z|-x|-y|-z]
                  [--reference LABEL REFERENCE.csv [--band-source TEXT]] [--time-panel] [--title TEXT]

@@ -1,6 +1,6 @@
 #pragma once
-// The reference cache of a study (issue 7: "cached by the hash of the scene and solver settings,
-// so a re-run reuses it"). A reference solve is identified by every input that changes its
+// The reference cache of a study: cached by the hash of the scene and the solver settings, so a
+// re-run reuses it. A reference solve is identified by every input that changes its
 // numbers: the scene (its file, the geometry it meshes, the materials, the sampled trajectory at
 // the solved samples — a trajectory scaled or replayed in memory is not in the file) and the
 // solver settings (FE degree, mesh level, linear solver and its tolerances, Newton tolerances,

@@ -1,6 +1,5 @@
 #pragma once
-// The solution verification of a study's reference on one scene (issue 21, "Solution verification
-// in every study"): the scene's force profiles at its three finest mesh levels, compared on the
+// The solution verification of a study's reference on one scene (every study does one): the scene's force profiles at its three finest mesh levels, compared on the
 // samples all three solved, give the observed order, the Richardson-extrapolated value and the GCI
 // (solution_verification.hpp) of two trajectory-wide quantities of the tool's force F:
 //

@@ -1,5 +1,5 @@
 #pragma once
-// Stability at the extremes (issue 7): a model run on a scene whose numbers are pushed one axis at
+// Stability at the extremes (docs/studies.md): a model run on a scene whose numbers are pushed one axis at
 // a time — servo rate, stiffness over six decades, toughness, tool speed, near-incompressibility,
 // mesh size — and every run classified. Every model must fail gracefully past its edge: a clear
 // refusal or a guarded state, never a NaN force and never a crash.

@@ -1,5 +1,5 @@
 #pragma once
-// A study under MPI (issue 7): `mpirun -np N kerf study …` spreads the runs of one study over the
+// A study under MPI: `mpirun -np N kerf study …` spreads the runs of one study over the
 // ranks (study_runner.hpp, StudyExecution). Compiled into the kerf program only — the one target
 // that links MPI::MPI_CXX; kerf_experiments and realtime/ know nothing of MPI.
 

@@ -1,5 +1,5 @@
 #pragma once
-// What a study writes once its runs are done (issue 23, "tables and plots an author can submit"):
+// What a study writes once its runs are done (tables and plots an author can submit):
 // the table (study.md/.tex/.csv), the reference's solution verification (verification.md/.csv),
 // and per scene the profile plot with the reference and its band (SCENE_profiles.png/.pdf/.csv)
 // and the speed/accuracy chart (SCENE_pareto.png/.pdf/.csv). Every figure has its data beside it.

@@ -588,7 +588,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
           if (!scored.reference.rows.empty())
             row.metrics = compare_profiles(at_common_times(profile, scored.reference), at_common_times(scored.reference, profile),
                                            tool, expected_cutting(scene));
-          // An error the reference cannot resolve is not shown as a number (issue 21): compared in
+          // An error the reference cannot resolve is not shown as a number: compared in
           // newtons with the uncertainty of the finest reference's RMS |F| and peak |F|.
           if (row.metrics && rms_uncertainty)
             row.rms_below_reference_uncertainty =

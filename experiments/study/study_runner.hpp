@@ -1,7 +1,7 @@
 #pragma once
 // Running a study: every model on every scene it can represent, the reference at each mesh level
 // (cached by the hash of the scene and the solver settings), metrics against the finest
-// reference, the reference's own discretisation error beside them, tables and plots (issue 7).
+// reference, the reference's own discretisation error beside them, tables and plots (docs/studies.md).
 
 #include "experiments/profile/force_profile.hpp"
 #include "experiments/run/run_model.hpp"

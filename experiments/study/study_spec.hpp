@@ -1,5 +1,5 @@
 #pragma once
-// A study file (experiments/studies/NAME.toml): scenes x models x resolutions (issue 7).
+// A study file (experiments/studies/NAME.toml): scenes x models x resolutions (docs/studies.md).
 //
 //   [study]
 //   name = "default"

@@ -17,8 +17,7 @@
 // Why kerf has its own numeric phase rather than calling cholmod_super_numeric: CHOLMOD as
 // Debian builds it opens an OpenMP parallel region per supernode (even on one thread, as an
 // `if` clause), and libgomp allocates and frees a thread team for each one: a heap allocation
-// inside the realtime step (found by the sanitizer build's allocation hook, session 18;
-// docs/reliability.md). This class allocates only in `analyse`; `factorize` calls the BLAS and
+// inside the realtime step (the allocation counters see it; docs/reliability.md). This class allocates only in `analyse`; `factorize` calls the BLAS and
 // LAPACK kernels (on one thread) and touches no allocator.
 
 #include <cstddef>

@@ -1,5 +1,5 @@
 #pragma once
-// A lossy link for fault-injection tests of the haptic rig (issue 10): a UDP relay on loopback
+// A lossy link for fault-injection tests of the haptic rig (docs/reliability.md): a UDP relay on loopback
 // between the rig (a UdpDevice connected to the relay's port) and a device (DeviceEmulator). It
 // forwards the rig's force commands to the device untouched, logging each one, and damages the
 // device's state datagrams on their way to the rig: dropped, duplicated, reordered, truncated,

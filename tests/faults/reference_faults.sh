@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fault injection on `kerf reference` (issue 10, docs/reliability.md), through the command line
+# Fault injection on `kerf reference` (docs/reliability.md), through the command line
 # and nothing else: clay_pull on a 5 mm mesh (the scene as shipped, only element_size changed, so
 # one run takes seconds), 11 evenly spaced samples (checkpoints after samples 5 and 10).
 #   1. an uninterrupted run: the profile every other run must reproduce;
@@ -60,8 +60,8 @@ whole_s=$($py -c "import sys; print(max(1.0, float(sys.argv[2]) - float(sys.argv
 [ "$(wc -l < whole/profile.csv)" -eq $((samples + 1)) ] || fail "uninterrupted profile has $(wc -l < whole/profile.csv) lines"
 check_whole whole
 # The solve's own wall time (the run's last line), without the process's start and the meshing
-# into the cache that only the first run does: under ASan + UBSan the first run took 73 s of which
-# the solve was 8 s, and kill times scaled to 73 s fell after the later, cached runs had ended.
+# into the cache that only the first run does: under ASan + UBSan the first run takes 73 s of which
+# the solve is 8 s, and kill times scaled to 73 s would fall after the later, cached runs end.
 solve_s=$(grep -o 'wall [0-9.]* s' whole.log | tail -1 | cut -d' ' -f2)
 [ -n "$solve_s" ] || { cat whole.log; fail "no solve wall time in the uninterrupted run's log"; }
 echo "uninterrupted: $samples samples in $whole_s s (the solve $solve_s s)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Fault injection on `kerf study` (issue 10, docs/reliability.md), through the command line: a
+# Fault injection on `kerf study` (docs/reliability.md), through the command line: a
 # small study (sponge_cut_constant and potato_rect_cut, the voxel and fracture models, the
 # reference at 4 samples on the coarsest mesh: two reference solves) is SIGKILLed half way, right
 # after its first reference solve reached the cache. Then:

@@ -1,4 +1,4 @@
-// Fault injection on the live haptic rig (issue 10, docs/reliability.md): the servo loop, its
+// Fault injection on the live haptic rig (docs/reliability.md): the servo loop, its
 // safety layer and the session recorder driving an emulated device over loopback UDP through a
 // lossy link (lossy_link.hpp) that drops (10% and 50%), duplicates, reorders, truncates, stalls
 // and finally cuts the device's state datagrams; and models that return NaN or throw mid-session.

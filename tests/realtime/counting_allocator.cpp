@@ -79,8 +79,8 @@ void on_sanitizer_free(const volatile void*) {}
 } // namespace
 #elif defined(__GLIBC__)
 // Eigen and C code allocate with malloc directly: count those too, through glibc's own entry
-// points. The aligned family as well: libgomp allocates its thread teams with aligned_alloc, which
-// only the sanitizer build's hook saw until session 19 (docs/reliability.md, session 18).
+// points. The aligned family as well: libgomp allocates its thread teams with aligned_alloc, and
+// the Release counter must see what the sanitizer build's hook sees (docs/reliability.md).
 extern "C" {
 void* __libc_malloc(std::size_t);
 void* __libc_calloc(std::size_t, std::size_t);

@@ -9,8 +9,8 @@
 // The per-thread switch lives only inside counting_allocator.cpp, behind set_counting: GCC 12 at
 // -O2 with UBSan null-checks the address of an extern thread_local with the flags of an
 // `add x@gottpoff(%rip), %rax` that GNU ld then relaxes into a `lea` (which sets no flags), so the
-// check fired on a valid address in every test that wrote the flag directly (session 18's
-// sanitizer stage; objdump of test_realtime_no_allocation, docs/reliability.md).
+// check fires on a valid address in every test that writes the flag directly (objdump of
+// test_realtime_no_allocation under the sanitizer build).
 
 #include <atomic>
 

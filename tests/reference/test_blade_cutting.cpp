@@ -32,7 +32,7 @@ namespace kerf {
 namespace {
 
 /// The scene `name` as its file gives it, with the thin blade of this file's route: σ_c = 1 MPa
-/// (δ_f = 2 J_c/σ_c = 0.4 mm) and a blade 0.5 mm thick (> δ_f). Throws if the file no longer does.
+/// (δ_f = 2 J_c/σ_c = 0.4 mm) and a blade 0.5 mm thick (> δ_f). Throws if the file gives other values.
 Scene thin_blade_scene(const std::string& name) {
   Scene scene = read_scene(std::filesystem::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / (name + ".toml"));
   if (std::abs(scene.material.cohesive_strength - 1e6) > 1e-6 || scene.tools.empty() ||
@@ -101,7 +101,7 @@ TEST(BladeCutting, SteadyCuttingForceIsToughnessTimesContactLength) {
   std::printf("steady cutting 4-10 mm: mean force %.4f N, dW/dx %.4f N, dD/dx %.4f N, dU/dx %.4f N, J_c l %.4f N, "
               "failed area per advance %.2f mm\n",
               mean_force, work_rate, dissipation_rate, stored_rate, Jc_l, rate("failed_area_m2") * 1e3);
-  // Eq. 10: the steady cutting force is J_c l (issue 4: within 10%).
+  // Eq. 10: the steady cutting force is J_c l (required within 10%).
   EXPECT_NEAR(work_rate, Jc_l, 0.10 * Jc_l);
   EXPECT_NEAR(mean_force, Jc_l, 0.10 * Jc_l);
   // Eq. 9: the crack advances with the blade over the whole contact length, and dissipates J_c per area.
@@ -118,7 +118,7 @@ TEST(BladeCutting, SteadyCuttingForceIsToughnessTimesContactLength) {
   const double half_angle = 0.5 * scene.tools.front().blade.wedge_angle;
   const double trailing = 0.4e-3 / (2.0 * std::tan(half_angle));
   EXPECT_NEAR(profile.rows.back().crack_extent, 10e-3 - trailing, 1e-3);
-  // Energy balance of the whole run (issue 4: 1%).
+  // Energy balance of the whole run (required within 1%).
   EXPECT_LT(std::abs(manifest.at("energy").at("balance_error").get<double>()), 0.01);
   std::filesystem::remove_all(run.dir);
 }

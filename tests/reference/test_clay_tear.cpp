@@ -8,7 +8,7 @@
 //                  dissipation is J_c A = 20 mJ (the area under the bilinear law, per area);
 //   free halves    afterwards the hands feel nothing: each half rests on a frictionless base;
 //   equilibrium    the hands' pulls are equal and opposite (the base takes no force along x);
-//   energy         work = strain + interface energy + cohesive + viscous dissipation (issue 4: 1%)
+//   energy         work = strain + interface energy + cohesive + viscous dissipation (within 1%)
 //                  while the tear is under way (docs/cohesive-fracture.md: after the last ligament
 //                  parts, the freed halves' recoil leaves the quasi-static ledger).
 

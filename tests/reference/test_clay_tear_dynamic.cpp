@@ -15,7 +15,7 @@
 //   separation     the failed area reaches the whole plane A = 20 mm × 20 mm and the cohesive
 //                  dissipation is J_c A = 20 mJ (the area under the bilinear law, per area);
 //   energy         W = U + K + interface energy + cohesive dissipation + damping dissipation at
-//                  every sample, to 1% (issue 4), without booking the time integration's error at
+//                  every sample, to 1%, without booking the time integration's error at
 //                  the law's kinks: the trapezoidal rule's energy identity (Hughes, The Finite
 //                  Element Method, §9.1) for the hands' work from their reactions;
 //   kinks          the time integration's error at the law's kinks (measured point by point and
@@ -23,7 +23,7 @@
 //                  0.5% of the dissipation J_c A plus 10⁻⁵ J_c A per accepted step (reference/
 //                  load_path.hpp), 0.5% + 0.14% for the ~140 steps of this run;
 //   kinetic        once separated the halves carry the energy they released as kinetic energy
-//                  (it was 38% of the work that left the quasi-static ledger): on average over
+//                  (in the quasi-static run, 38% of the work leaves the ledger there): on average over
 //                  the samples after separation more than 20% of W;
 //   peak           the hands' peak pull lies within 3% of the last quasi-static equilibrium
 //                  before the tear ran away, 12.41 N (the unregularised quasi-static path's last
@@ -155,7 +155,7 @@ TEST(ClayTearDynamic, TearToSeparationKeepsTheEnergyBalance) {
   ASSERT_GT(after, 20);
   EXPECT_GT(kinetic / after, 0.2 * last.at("external_work_J").get<double>());
   // The time integration's error at the law's kinks: below 1% of J_c A under the interface energy
-  // control (the bound in the file comment; without the control it was 14.3% of J_c A on these
+  // control (the bound in the file comment; without the control it is 14.3% of J_c A on these
   // samples, docs/cohesive-fracture.md).
   const double kinks = last.at("cohesive_time_integration_J").get<double>();
   EXPECT_LT(std::abs(kinks), 0.01 * r.toughness * r.plane);

@@ -19,7 +19,7 @@ namespace {
 
 CohesiveLawParameters potato() {
   CohesiveLawParameters p;
-  p.cohesive_strength = 0.5e6;  // an estimate of potato's σ_c (0.3-1 MPa; the scenes carried it until session 16, now 1 MPa)
+  p.cohesive_strength = 0.5e6;  // within potato's σ_c range (0.3-1 MPa; two_layer_cut's lower layer; the potato scenes take 1 MPa)
   p.fracture_toughness = 200.0; // the potato scenes' J_c (paper 001 footnote 1)
   p.initial_opening_ratio = 0.01;
   p.shear_weight = 1.0;

@@ -12,8 +12,8 @@ namespace kerf::reference {
 namespace {
 
 TEST(CohesiveZone, RiceEstimate) {
-  // The potato scenes' material before session 16 (E = 3 MPa, ν = 0.45, J_c = 200 J/m²,
-  // σ_c = 0.5 MPa; the scenes now carry 1 MPa): l_cz = (9π/32) E/(1−ν²) J_c/σ_c², evaluated by hand:
+  // Potato tissue with σ_c = 0.5 MPa (E = 3 MPa, ν = 0.45, J_c = 200 J/m²; two_layer_cut's lower
+  // layer; the potato scenes carry 1 MPa): l_cz = (9π/32) E/(1−ν²) J_c/σ_c², evaluated by hand:
   // 0.883573 × 3.761755e6 × 200 / 2.5e11 = 2.65903 mm.
   EXPECT_NEAR(cohesive_zone_length(3e6, 0.45, 200.0, 0.5e6), 2.65903e-3, 1e-8);
   // Halving σ_c quadruples the zone (l_cz ∝ 1/σ_c²).

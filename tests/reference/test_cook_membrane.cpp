@@ -30,7 +30,7 @@ double cook_tip_displacement(int n, int degree, bool plane_strain, const Eigen::
 
 TEST(CookMembrane, P2TetrahedraConvergeToThePlaneStrainValue) {
   // Independent value: FEBio 4.11 on quadratic tetrahedra with the code gallery's energy, 16.7k
-  // DOFs, 10 load steps: 14.737 mm (issue 3's measurement; 14.731 mm at 4.6k DOFs).
+  // DOFs, 10 load steps: 14.737 mm (14.731 mm at 4.6k DOFs; experiments/benchmarks/febio_cook.sh re-runs it).
   // The gallery README's "14.33 mm" was produced before its commit a587098 (2021), when the
   // z faces were left unconstrained (boundary ids tested center()[0] instead of [2]) and the tip
   // was read at (48, 60) mm: it is not the plane-strain problem of today's program (docs/reference.md).

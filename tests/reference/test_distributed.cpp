@@ -1,5 +1,5 @@
-// The distributed reference (issue 3, "mpirun -np N … gives the same profile as the serial run to
-// solver tolerance"). ctest runs this program as `mpirun -np 2`: on every process the same
+// The distributed reference: `mpirun -np N …` gives the same profile as the serial run to solver
+// tolerance. ctest runs this program as `mpirun -np 2`: on every process the same
 // problem is solved twice, serially on this process alone (SolverSettings::distribute = false:
 // deal.II vectors, UMFPACK) and distributed over both processes (fully distributed
 // triangulation, PETSc MPI vectors, MUMPS or CG + GAMG); the second method must reproduce the

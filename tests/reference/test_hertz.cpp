@@ -9,7 +9,7 @@
 // a/R ≤ 0.05 keeps the finite-strain solution within ~1% of the small-strain Hertz theory.
 // Measured (docs/reference.md, "Hertz indentation"): P2 on this mesh +1.1% … +2.0% for
 // d = 10 … 50 µm; P1 on a 0.15 mm contact zone +5.7% … +6.1% (the stiff linear tetrahedra), and
-// +4.8% … +5.3% on a block four times deeper and wider. Tolerance: issue 3's 5%, at every depth;
+// +4.8% … +5.3% on a block four times deeper and wider. Tolerance: 5% (the required accuracy of the reference), at every depth;
 // the exponent of F(d) between the smallest and largest depth within 0.05 of 3/2.
 
 #include "meshes/gmsh_io.hpp"

@@ -77,7 +77,7 @@ TEST(LoadPath, StopsNamingTheSampleAndKeepsTheLastConvergedState) {
   EXPECT_THROW((void)LoadPath(solver, LoadState{}, LoadPathSettings{-1}), std::invalid_argument);
 }
 
-// A NaN in the residual (reference::SolverSettings::residual_fault, issue 10) is a failed solve:
+// A NaN in the residual (reference::SolverSettings::residual_fault; docs/reliability.md) is a failed solve:
 // never "converged" (a NaN compares false with every tolerance, so a convergence test written the
 // other way round would pass it), the state restored; the load path cuts back and, once the fault
 // is gone, reaches the equilibrium a clean solver reaches (path independence, as above).

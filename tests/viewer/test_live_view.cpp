@@ -90,7 +90,7 @@ LiveViewReport session(const std::string& scene_name, const std::string& model_n
 /// own ways of delaying the servo: making the stepping thread wait — measured directly, in every
 /// viewed session: no snapshot may wait (ViewedModel::blocked_snapshots, the thread's voluntary
 /// context switches across it) — and taking CPU from it, which on 2 shared cores is what the
-/// other engineers' compilers do too, and shows only in the overrun counts.
+/// other processes on the machine do too, and shows only in the overrun counts.
 ///
 /// The counter: `pairs` pairs of equal sessions, the one without the view first in even pairs and
 /// second in odd ones (a load that drifts over the test weighs on both sides alike), compared by
@@ -127,7 +127,7 @@ void expect_no_overrun(const std::string& scene, const std::string& model, doubl
     // next frame time), so n steps of dt publish at least n dt / (1/rate + dt) frames; at least
     // half of those are asked for, and two. Not a fixed count: under the sanitizers the spring
     // network's 100 Hz thread takes far longer than its period per step, its clock falls behind
-    // and a 1.5 s session publishes 5-10 frames (CI's sanitizer stage, session 19), where Release
+    // and a 1.5 s session publishes 5-10 frames (CI's sanitizer stage), where Release
     // publishes 81 (161 model steps).
     const double model_dt = 1.0 / (model_rate > 0.0 ? model_rate : servo_rate);
     const std::uint64_t model_steps = model_rate > 0.0 ? on.servo.model_steps : on.servo.timing.ticks;

@@ -1,4 +1,4 @@
-// Calibration recovers known parameters from a profile that the model itself generated (issue 7),
+// Calibration recovers known parameters from a profile that the model itself generated,
 // and the parameter file it writes is read back by the scene reader with its units.
 //
 // Tolerance: the target is the model's own output on the same trajectory, so the objective is

@@ -266,7 +266,7 @@ TEST(ReferenceRun, DynamicResumeCarriesVelocityAndAcceleration) {
   EXPECT_NE(message.find("with the scene's Kelvin-Voigt damping and this run is undamped"), std::string::npos) << message;
 }
 
-// Fault injection (issue 10, docs/reliability.md): a NaN in the assembled residual of a Newton
+// Fault injection (docs/reliability.md): a NaN in the assembled residual of a Newton
 // iteration (reference::SolverSettings::residual_fault), as an overflowing material or contact term
 // would make it.
 //  - Once, in the first attempt at sample 2: the solve must fail rather than "converge" on a NaN

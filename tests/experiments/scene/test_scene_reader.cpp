@@ -64,7 +64,7 @@ TEST(Scenes, EverySceneFileReads) {
       EXPECT_DOUBLE_EQ(t.trajectory.rate, 1000.0);
       EXPECT_FALSE(t.trajectory.segments.empty());
     }
-    // every cutting scene carries paper 001's responses (the brief of issue 7)
+    // every cutting scene carries paper 001's responses (the fracture model and its calibration need them)
     if (s.phenomena.contains(Phenomenon::cutting)) {
       EXPECT_TRUE(s.fracture.has_value());
     }

@@ -422,7 +422,7 @@ ReferenceRunner fracture_as_reference(std::atomic<int>& solves, double rupture_f
 } // namespace
 
 TEST(StudyRunner, AChangedSolverSettingMissesTheCacheAnUnchangedOneHitsIt) {
-  // Issue 7: the reference is "cached by the hash of the scene and solver settings". One scene,
+  // The reference is cached by the hash of the scene and the solver settings. One scene,
   // one level: each run below says how many reference solves it did.
   StudySpec spec = read_study(write_study("cache.toml", "[study]\nname = \"cache\"\nscenes = [\"potato_rect_cut\"]\n"
                                                         "models = [\"fracture\"]\n[reference]\nrefinements = [0]\nsamples = 8\n"));
@@ -607,7 +607,7 @@ TEST(StudyRunner, TheCalibrationTrajectoryIsTheSamePathPlayedFaster) {
 }
 
 TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
-  // Issue 7: "the study reports calibrated and uncalibrated rows side by side" — the default study
+  // The study reports calibrated and uncalibrated rows side by side: the default study
   // fits every model `kerf calibrate` supports that runs on its scenes: the springs on clay_pull
   // and the fracture model on potato_rect_cut (voxel runs on neither scene).
   const StudySpec s = read_study(fs::path(KERF_STUDIES_DIR) / "default.toml");

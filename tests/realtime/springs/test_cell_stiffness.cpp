@@ -87,8 +87,8 @@ TEST(CellStiffness, UniaxialBlockMatchesEAndNu) {
       for (int axis = 0; axis < 3; ++axis) {
         const auto [E_eff, nu_eff] = uniaxial(id, h, 4, axis);
         SCOPED_TRACE(testing::Message() << "volume term " << volume << ", nu " << nu << ", axis " << axis);
-        // Issue 5: E within 5% after calibration; ν = 1/4 without the volume term, the
-        // scene's ν within 5% with it.
+        // Expected: the identification of docs/spring-network.md §1 — E, and ν = 1/4 without the
+        // volume term (the Cauchy relation of central springs), the scene's ν with it; within 5%.
         EXPECT_NEAR(E_eff, E, 0.05 * E);
         EXPECT_NEAR(nu_eff, volume ? nu : 0.25, 0.05 * (volume ? nu : 0.25));
       }

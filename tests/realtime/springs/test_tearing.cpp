@@ -1,5 +1,5 @@
 // Tearing (paper 000 §2.2) on the clay_tear setting: two styluses pull a clay bar apart until the
-// network separates (issue 5); the tear carried into the fine mesh gives two components whose
+// network separates into two pieces; the tear carried into the fine mesh gives two components whose
 // volumes add up to the original (an exact tiling: volume is conserved), with no inverted
 // tetrahedron, and the mode is deformation-1 until the tearing sample, rupture on it.
 
