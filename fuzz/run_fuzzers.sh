@@ -7,12 +7,22 @@
 # BUILD/fuzz/crashes/TARGET/ (add it to fuzz/regressions/TARGET/ with the fix).
 #
 #   bash fuzz/run_fuzzers.sh [SECONDS_PER_TARGET [TARGET...]]    # default 30 s, every target
+#   bash fuzz/run_fuzzers.sh --campaign CPU_SECONDS [TARGET...]    # the long campaign
+#
+# Every run also reads the kept corpus fuzz/corpus/TARGET/ (committed; read only in a short run).
+# A campaign runs each target until it has spent CPU_SECONDS of CPU time in total, counted over
+# every campaign run of that target in fuzz/campaign.tsv (so it resumes where it was stopped, and a
+# niced run on a busy machine counts only the CPU it got). Each chunk appends one line to the ledger
+# (target, CPU seconds, executions, finding or none, libFuzzer's coverage), then the kept corpus is
+# minimised with libFuzzer's -merge=1 into fuzz/corpus/TARGET/. Commit both.
 #
 # KERF_FUZZ_BUILD_DIR overrides the build folder (default: build-fuzz beside the sources);
 # KERF_FUZZ_SEED fixes libFuzzer's random seed (CI: 1; default 0, a new seed each run).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${KERF_FUZZ_BUILD_DIR:-$here/build-fuzz}"
+campaign=0
+if [ "${1:-}" = "--campaign" ]; then campaign=1; shift; fi
 seconds="${1:-30}"
 shift || true
 targets=("$@")
@@ -21,16 +31,61 @@ targets=("$@")
 cmake -S "$here" -B "$build" -DKERF_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo > /dev/null
 cmake --build "$build" -j2
 
+ledger="$here/fuzz/campaign.tsv"
+[ -f "$ledger" ] || printf 'target\tcpu_seconds\texecutions\tresult\tcoverage\n' > "$ledger"
+# CPU seconds (user + system) one process has used so far, from /proc/PID/stat fields 14 and 15.
+cpu_seconds_of() { awk -v hz="$(getconf CLK_TCK)" '{ print int(($14 + $15) / hz) }' "/proc/$1/stat" 2> /dev/null || echo 0; }
+spent_on() { awk -F'\t' -v t="$1" '$1 == t { s += $2 } END { print s + 0 }' "$ledger"; }
+
 status=0
 for t in "${targets[@]}"; do
   corpus="$build/fuzz/corpus/$t"
   crashes="$build/fuzz/crashes/$t"
-  mkdir -p "$corpus" "$crashes"
+  kept="$here/fuzz/corpus/$t"
+  mkdir -p "$corpus" "$crashes" "$kept"
   log="$build/fuzz/$t.log"
-  # New inputs go to corpus/ (kept between runs of one build folder); seeds/ is read only.
+  if [ $campaign -eq 1 ]; then
+    budget=$((seconds - $(spent_on "$t")))
+    if [ $budget -le 0 ]; then echo "fuzz_$t: campaign done ($(spent_on "$t") CPU s in $ledger)"; continue; fi
+    # New inputs go to corpus/ in the build; the kept corpus and the seeds are read only.
+    "$build/fuzz/fuzz_$t" -timeout=60 -rss_limit_mb=2048 -print_final_stats=1 -seed="${KERF_FUZZ_SEED:-0}" \
+      -artifact_prefix="$crashes/" "$corpus" "$kept" "$build/fuzz/seeds/$t" > "$log" 2>&1 &
+    pid=$!
+    used=0
+    while kill -0 $pid 2> /dev/null; do
+      sleep 5
+      now=$(cpu_seconds_of $pid)
+      [ "$now" -gt 0 ] && used=$now
+      if [ "$used" -ge "$budget" ]; then kill -INT $pid 2> /dev/null || true; fi
+    done
+    rc=0; wait $pid || rc=$?
+    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
+    cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1 | grep -oE '[0-9]+' || echo "?")
+    # libFuzzer exits 0 or 72 (interrupted) without a finding; a finding leaves a crash-/leak-/timeout- file.
+    if ls "$crashes"/* > /dev/null 2>&1 || { [ $rc -ne 0 ] && [ $rc -ne 72 ] && [ $rc -ne 130 ]; }; then
+      result=finding; status=1
+      echo "fuzz_$t: FINDING after $used CPU s (log $log, input in $crashes/):"
+      grep -E 'ERROR|runtime error|SUMMARY|what\(\)|Test unit written' "$log" | head -8 || true
+    else
+      result=none
+      echo "fuzz_$t: $used CPU s, $runs executions, coverage $cov, no finding ($(( $(spent_on "$t") + used )) CPU s in all)"
+    fi
+    printf '%s\t%s\t%s\t%s\t%s\n' "$t" "$used" "$runs" "$result" "$cov" >> "$ledger"
+    # Minimise: the kept corpus becomes the smallest set with the coverage of both.
+    merged="$build/fuzz/merged/$t"
+    rm -rf "$merged"; mkdir -p "$merged"
+    if "$build/fuzz/fuzz_$t" -merge=1 -timeout=60 -rss_limit_mb=2048 "$merged" "$kept" "$corpus" \
+         > "$build/fuzz/$t.merge.log" 2>&1; then
+      rm -rf "$kept"; mv "$merged" "$kept"
+    else
+      echo "fuzz_$t: the merge failed (log $build/fuzz/$t.merge.log); the kept corpus is unchanged"; status=1
+    fi
+    continue
+  fi
+  # New inputs go to corpus/ (kept between runs of one build folder); the kept corpus and seeds/ are read only.
   if "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=60 -rss_limit_mb=2048 -print_final_stats=1 \
        -seed="${KERF_FUZZ_SEED:-0}" \
-       -artifact_prefix="$crashes/" "$corpus" "$build/fuzz/seeds/$t" > "$log" 2>&1; then
+       -artifact_prefix="$crashes/" "$corpus" "$kept" "$build/fuzz/seeds/$t" > "$log" 2>&1; then
     runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
     echo "fuzz_$t: ${seconds} s, ${runs} executions, no finding"
   else

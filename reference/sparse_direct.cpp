@@ -31,6 +31,10 @@ struct SparseDirect::Cholmod {
     // Always the supernodal L Lᵀ: CHOLMOD's simplicial LDLᵀ (its choice for small, sparse factors)
     // would factorise an indefinite matrix without pivoting instead of reporting it.
     common.supernodal = CHOLMOD_SUPERNODAL;
+    // A matrix that is not positive definite is an expected answer here (the LU takes over, and
+    // the counters record it), not a warning to print on stderr at every Newton iteration.
+    common.print = 0;
+    common.error_handler = nullptr;
   }
   ~Cholmod() {
     if (L) cholmod_l_free_factor(&L, &common);

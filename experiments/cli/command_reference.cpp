@@ -51,6 +51,7 @@ struct ReferenceOptions {
   double until = -1.0; ///< < 0: the whole trajectory; else only samples with t <= until [s]
   int levels = 0;      ///< 0: one run; >= 3: a convergence study over that many refinements
   std::string element_size; ///< overrides the scene's element size ("5 mm"); empty = the scene's
+  std::string grasp_element_size; ///< overrides the grasp rims' derived element size; empty = derived
   bool resume = false;
   std::string fracture = "auto";
   std::string mesh = "reference"; ///< "reference": the scene meshed for the reference (graded); "scene": its own mesh
@@ -79,6 +80,7 @@ struct ReferenceOptions {
   if (o.until >= 0.0) args.insert(args.end(), {"--until", std::to_string(o.until)});
   if (o.levels > 0) args.insert(args.end(), {"--levels", std::to_string(o.levels)});
   if (!o.element_size.empty()) args.insert(args.end(), {"--element-size", o.element_size});
+  if (!o.grasp_element_size.empty()) args.insert(args.end(), {"--grasp-element-size", o.grasp_element_size});
   args.insert(args.end(), {"--fracture", o.fracture, "--mesh", o.mesh});
   args.insert(args.end(), {"--adaptive", std::to_string(o.adaptive), "--min-travel", std::to_string(o.min_travel_mm)});
   if (o.viscous_time > 0.0) args.insert(args.end(), {"--cohesive-viscous-time", std::to_string(o.viscous_time)});
@@ -118,6 +120,11 @@ void run_reference_command(const ReferenceOptions& o) {
   // A recorded session replays what the hand did at the rig through the ground truth.
   Scene scene = o.trajectory.empty() ? read : replay_session(read, o.trajectory, out);
   if (!o.element_size.empty()) scene.geometry.element_size = parse_quantity(o.element_size, Dimension::length);
+  if (!o.grasp_element_size.empty()) {
+    const double size = parse_quantity(o.grasp_element_size, Dimension::length);
+    if (!(size > 0.0)) throw std::invalid_argument("--grasp-element-size " + o.grasp_element_size + ": expected a positive length");
+    scene.geometry.grasp_element_size = size;
+  }
   ReferenceRunSettings settings;
   settings.degree = o.degree;
   settings.refinements = o.refine;
@@ -200,6 +207,9 @@ void add_reference_command(CLI::App& app) {
       ->check(CLI::Range(3, 5));
   cmd->add_option("--element-size", options->element_size,
                   "mesh the scene with this element size instead of its own (a length, e.g. \"5 mm\")");
+  cmd->add_option("--grasp-element-size", options->grasp_element_size,
+                  "the element size on each grasp rim instead of the one derived from the scene (a length; for a study of "
+                  "the rim's resolution, docs/reference.md)");
   cmd->add_option("-o,--output", options->out, "output directory (default runs/SCENE/reference)");
   cmd->add_flag("--resume", options->resume, "continue from DIR/checkpoint.bin");
   cmd->add_flag("--no-fields", options->no_fields, "do not write fields.pvd and the .vtu files");

@@ -526,10 +526,12 @@ private:
     if (const auto law = layer ? optional_string(t, "law") : std::optional(required_string(t, "law"))) {
       if (*law == "neo-hookean")
         m.law = MaterialLaw::neo_hookean;
+      else if (*law == "decoupled-neo-hookean")
+        m.law = MaterialLaw::decoupled_neo_hookean;
       else if (*law == "st-venant-kirchhoff")
         m.law = MaterialLaw::st_venant_kirchhoff;
       else
-        wrong(*t.find("law"), t, t.key("law"), "\"neo-hookean\" or \"st-venant-kirchhoff\"");
+        wrong(*t.find("law"), t, t.key("law"), "\"neo-hookean\", \"decoupled-neo-hookean\" or \"st-venant-kirchhoff\"");
     }
 
     // Required in the base material; cutting/tearing need J_c and σ_c, friction needs μ.
@@ -810,6 +812,15 @@ private:
 };
 
 } // namespace
+
+const char* material_law_name(MaterialLaw law) {
+  switch (law) {
+  case MaterialLaw::neo_hookean: return "neo-hookean";
+  case MaterialLaw::decoupled_neo_hookean: return "decoupled-neo-hookean";
+  case MaterialLaw::st_venant_kirchhoff: return "st-venant-kirchhoff";
+  }
+  return "?";
+}
 
 Scene read_scene(const fs::path& file, const std::vector<fs::path>& parameter_files) {
   return SceneParser(file, parameter_files).read();

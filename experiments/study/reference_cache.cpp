@@ -49,7 +49,7 @@ std::string exact(double v) {
 }
 
 std::string material_line(const Material& m) {
-  return m.region + ": law " + (m.law == MaterialLaw::neo_hookean ? "neo-hookean" : "st-venant-kirchhoff") + ", E " +
+  return m.region + ": law " + material_law_name(m.law) + ", E " +
          exact(m.youngs_modulus) + ", nu " + exact(m.poisson_ratio) + ", rho " + exact(m.density) + ", J_c " +
          exact(m.fracture_toughness) + ", sigma_c " + exact(m.cohesive_strength) + ", mu " + exact(m.friction_coefficient) +
          ", eta " + exact(m.damping);

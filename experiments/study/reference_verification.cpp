@@ -37,6 +37,12 @@ std::string describe(const char* name, double value, const GridConvergence& c) {
   return text;
 }
 
+std::string format_order(double p) {
+  char text[32];
+  std::snprintf(text, sizeof text, "the formal %.2g", p);
+  return text;
+}
+
 } // namespace
 
 std::optional<double> ReferenceVerification::rms_uncertainty() const {
@@ -53,10 +59,19 @@ std::string ReferenceVerification::summary() const {
   char where[200];
   std::snprintf(where, sizeof where, "; from L%d, L%d, L%d (h = %.3g, %.3g, %.3g mm) on %zu common samples", levels[0], levels[1], levels[2],
                 element_sizes[0] * 1e3, element_sizes[1] * 1e3, element_sizes[2] * 1e3, samples);
-  return describe("RMS |F|", rms_force, rms) + "; " + describe("peak |F|", peak_force, peak) + where;
+  char text[400];
+  if (profile.usable() && peak_force > 0.0)
+    std::snprintf(text, sizeof text, "uncertainty %.2g %% of the peak on the force profile (%.3g N RMS; level differences %.3g, %.3g N RMS, p = %.2g%s); ",
+                  100.0 * *profile.uncertainty / peak_force, *profile.uncertainty, profile.e21, profile.e32, *profile.observed_order,
+                  *profile.order_used < *profile.observed_order ? (", used " + format_order(*profile.order_used)).c_str() : "");
+  else
+    std::snprintf(text, sizeof text, "no uncertainty on the force profile: %s; ",
+                  profile.usable() ? "the finest level has no force" : profile.unusable.c_str());
+  return text + describe("RMS |F|", rms_force, rms) + "; " + describe("peak |F|", peak_force, peak) + where;
 }
 
-std::optional<ReferenceVerification> verify_reference(const std::vector<ReferenceLevel>& levels, const std::string& tool) {
+std::optional<ReferenceVerification> verify_reference(const std::vector<ReferenceLevel>& levels, const std::string& tool,
+                                                      double formal_order) {
   if (levels.size() < 3) return std::nullopt;
   const auto sorted = by_element_size(levels);
   // The samples all three finest levels solved.
@@ -67,6 +82,7 @@ std::optional<ReferenceVerification> verify_reference(const std::vector<Referenc
         if (a != b) common[a] = at_common_times(common[a], common[b]);
   ReferenceVerification v;
   double rms[3], peak[3];
+  std::vector<const ProfileRow*> rows_at[3];
   for (int k = 0; k < 3; ++k) {
     v.levels[k] = sorted[k]->level;
     v.element_sizes[k] = sorted[k]->element_size;
@@ -76,6 +92,7 @@ std::optional<ReferenceVerification> verify_reference(const std::vector<Referenc
                                   std::to_string(sorted[1]->level) + ", L" + std::to_string(sorted[2]->level) + ") share " +
                                   std::to_string(rows.size()) + " sample(s) of tool " + tool + ", fewer than 2");
     v.samples = rows.size();
+    rows_at[k] = rows;
     double sum = 0.0;
     peak[k] = 0.0;
     for (const ProfileRow* r : rows) {
@@ -88,6 +105,14 @@ std::optional<ReferenceVerification> verify_reference(const std::vector<Referenc
   v.peak_force = peak[0];
   v.rms = grid_convergence({v.element_sizes[0], v.element_sizes[1], v.element_sizes[2], rms[0], rms[1], rms[2]});
   v.peak = grid_convergence({v.element_sizes[0], v.element_sizes[1], v.element_sizes[2], peak[0], peak[1], peak[2]});
+  // The RMS over the common samples of the force differences between successive levels.
+  const auto rms_difference = [&](int a, int b) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < rows_at[a].size(); ++i) sum += (rows_at[a][i]->force - rows_at[b][i]->force).squaredNorm();
+    return std::sqrt(sum / static_cast<double>(rows_at[a].size()));
+  };
+  v.profile = difference_convergence(v.element_sizes[0], v.element_sizes[1], v.element_sizes[2], rms_difference(0, 1),
+                                     rms_difference(1, 2), formal_order);
   return v;
 }
 
@@ -100,13 +125,13 @@ ReferenceBand reference_band(const std::vector<ReferenceLevel>& levels, const st
   const auto fine = rows_of_tool(sorted[0]->profile, tool);
   std::vector<std::vector<const ProfileRow*>> others;
   for (std::size_t k = 1; k < sorted.size(); ++k) others.push_back(rows_of_tool(sorted[k]->profile, tool));
-  band.from_gci = verification && verification->rms.usable() && sorted.size() >= 2;
+  band.from_gci = verification && verification->profile.usable() && sorted.size() >= 2;
   for (const ProfileRow* r : fine) {
     const double f1 = resisting(r);
     const ProfileRow* medium = others.empty() ? nullptr : at_time(others.front(), r->t);
     if (band.from_gci && medium) {
       const double u = gci_band_half_width({f1}, {resisting(medium)}, sorted[1]->element_size / sorted[0]->element_size,
-                                           *verification->rms.observed_order)
+                                           *verification->profile.order_used)
                            .front();
       band.low.push_back(f1 - u);
       band.high.push_back(f1 + u);

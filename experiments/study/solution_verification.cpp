@@ -66,6 +66,50 @@ GridConvergence grid_convergence(const GridTriplet& g, double safety_factor) {
   return out;
 }
 
+DifferenceConvergence difference_convergence(double h1, double h2, double h3, double e21, double e32, double formal_order,
+                                             double safety_factor) {
+  if (!(h1 > 0.0) || !(h2 > h1) || !(h3 > h2) || !std::isfinite(h3))
+    throw std::invalid_argument("difference convergence: needs element sizes 0 < h1 < h2 < h3");
+  if (!(e21 >= 0.0) || !(e32 >= 0.0) || !std::isfinite(e21) || !std::isfinite(e32))
+    throw std::invalid_argument("difference convergence: needs finite difference norms >= 0");
+  if (!(formal_order > 0.0) || !std::isfinite(formal_order))
+    throw std::invalid_argument("difference convergence: needs a formal order > 0");
+  DifferenceConvergence c;
+  c.r21 = h2 / h1;
+  c.r32 = h3 / h2;
+  c.e21 = e21;
+  c.e32 = e32;
+  c.formal_order = formal_order;
+  if (e21 == 0.0) {
+    c.unusable = "the two finest levels agree at every sample: no difference to extrapolate from";
+    return c;
+  }
+  if (e32 <= e21) {
+    char why[160];
+    std::snprintf(why, sizeof why, "the level differences do not shrink under refinement (%.3g, then %.3g): no observed order", e32, e21);
+    c.unusable = why;
+    return c;
+  }
+  // g(p) = ln(r21^p (r32^p − 1) / (r21^p − 1)) rises from ln(ln r32 / ln r21) (p → 0) without
+  // bound: bisection on ln(e32/e21) = g(p), bracketed in (0, 64].
+  const double target = std::log(e32 / e21);
+  const auto g = [&](double p) { return p * std::log(c.r21) + std::log(std::expm1(p * std::log(c.r32)) / std::expm1(p * std::log(c.r21))); };
+  double low = 1e-9, high = 64.0;
+  if (target <= g(low)) {
+    c.unusable = "the level differences shrink too little for the refinement ratios: no positive observed order";
+    return c;
+  }
+  if (target >= g(high)) low = high;
+  for (int k = 0; k < 200 && high - low > 1e-13; ++k) {
+    const double mid = 0.5 * (low + high);
+    (g(mid) < target ? low : high) = mid;
+  }
+  c.observed_order = 0.5 * (low + high);
+  c.order_used = std::min(*c.observed_order, formal_order);
+  c.uncertainty = safety_factor * e21 / std::expm1(*c.order_used * std::log(c.r21));
+  return c;
+}
+
 std::vector<double> gci_band_half_width(const std::vector<double>& fine, const std::vector<double>& medium, double r21,
                                         double observed_order, double safety_factor) {
   if (fine.size() != medium.size())

@@ -59,6 +59,43 @@ struct GridConvergence {
 /// for sizes that are not strictly increasing and positive, or a non-finite φ.
 GridConvergence grid_convergence(const GridTriplet& grids, double safety_factor = gci_safety_factor);
 
+/// The discretisation error of a whole profile (a function of the trajectory, not one number),
+/// from the norms of the differences between successive levels, finest first:
+///
+///   e21 = ‖f2 − f1‖,  e32 = ‖f3 − f2‖   (any norm over the samples; the study's: RMS over them)
+///
+/// With the error ‖f_h − f‖ ≈ C h^p, f2 − f1 ≈ C h1^p (r21^p − 1) and f3 − f2 ≈ C h1^p r21^p
+/// (r32^p − 1), so the observed order p solves
+///
+///   e32 / e21 = r21^p (r32^p − 1) / (r21^p − 1)        (r^p for a constant ratio r)
+///
+/// and the uncertainty of the finest profile in that norm is Roache's GCI in absolute form,
+/// U = Fs e21 / (r21^q − 1) with q = min(p, p_formal): an observed order above the method's formal
+/// order is not trusted (Roache 1998, "Verification and Validation in Computational Science and
+/// Engineering": where the observed order exceeds the formal one, the GCI takes the formal order). Unlike the
+/// GCI of one trajectory-wide number (the RMS of |F|, whose levels may agree by coincidence while
+/// their profiles differ sample by sample), a norm of differences cannot cancel: it is zero only
+/// where the levels agree everywhere, and it is the scale of a model's RMS force error.
+/// Unusable, with the reason, when e21 = 0 (no difference to extrapolate from) or e32 <= e21
+/// (the differences do not shrink: no asymptotic range, no order).
+struct DifferenceConvergence {
+  double r21 = 0.0, r32 = 0.0;          ///< refinement ratios h2/h1, h3/h2
+  double e21 = 0.0, e32 = 0.0;          ///< norms of the level differences (input)
+  double formal_order = 0.0;            ///< p_formal, the cap of the order used
+  std::optional<double> observed_order; ///< p; empty when unusable
+  std::optional<double> order_used;     ///< q = min(p, p_formal)
+  std::optional<double> uncertainty;    ///< U = Fs e21 / (r21^q − 1), in the unit of e
+  std::string unusable;                 ///< why no uncertainty (empty when `uncertainty` is set)
+
+  [[nodiscard]] bool usable() const { return uncertainty.has_value(); }
+};
+
+/// The estimate above for element sizes h1 < h2 < h3 and the difference norms e21, e32 (>= 0).
+/// Throws std::invalid_argument for sizes not strictly increasing and positive, a negative or
+/// non-finite norm, or a formal order <= 0.
+DifferenceConvergence difference_convergence(double h1, double h2, double h3, double e21, double e32, double formal_order,
+                                             double safety_factor = gci_safety_factor);
+
 /// The half-width U_k of the uncertainty band of the finest solution at each sample k of a profile,
 /// from the finest (`fine`) and the next coarser (`medium`) level at the same samples:
 ///

@@ -12,7 +12,7 @@ namespace kerf {
 
 std::optional<double> rms_error_floor(const SceneReference& reference) {
   if (!reference.verification) return std::nullopt;
-  const auto u = reference.verification->rms_uncertainty();
+  const auto u = reference.verification->profile_uncertainty();
   if (!u || !(reference.verification->peak_force > 0.0)) return std::nullopt;
   return *u / reference.verification->peak_force;
 }
@@ -40,6 +40,14 @@ StudyTable verification_table(const StudyResult& result) {
                  std::string(!c->observed_order ? "none" : c->oscillatory ? "oscillatory" : "monotonic"), c->extrapolated,
                  O(c->approximate_relative_error), c->extrapolated_relative_error, c->gci_fine, c->unusable});
     }
+    // The force profile: its uncertainty in the RMS norm from the level differences (φ2, φ3: the
+    // RMS of f2 − f1 and f3 − f2), relative to the finest level's peak |F| in the GCI column.
+    const DifferenceConvergence& d = v.profile;
+    const std::string order_note = d.usable() && *d.order_used < *d.observed_order ? "order capped at the formal " + std::to_string(static_cast<int>(d.formal_order)) : d.unusable;
+    t.add_row({r.scene, std::string("force profile (RMS of level differences)"), levels, O(v.element_sizes[0]), O(v.element_sizes[1]),
+               O(v.element_sizes[2]), O(v.rms_force), O(d.e21), O(d.e32), O(d.r21), O(d.r32), d.observed_order,
+               std::string(d.usable() ? "monotonic" : "none"), O(), O(), O(),
+               d.usable() && v.peak_force > 0.0 ? O(*d.uncertainty / v.peak_force) : O(), order_note});
   }
   return t;
 }
@@ -75,7 +83,7 @@ ProfilePlotReference write_reference_series(const SceneReference& reference, con
   std::string source;
   if (band.from_gci) {
     char text_source[96];
-    std::snprintf(text_source, sizeof text_source, "GCI band (p = %.2g)", *reference.verification->rms.observed_order);
+    std::snprintf(text_source, sizeof text_source, "GCI band (p = %.2g)", *reference.verification->profile.order_used);
     source = text_source;
   } else if (levels.size() > 1) {
     source = "spread of L" + std::to_string(reference.levels.front()) + "..L" + std::to_string(reference.levels.back());

@@ -151,15 +151,7 @@ struct ModelRun {
   bool anchors_fits = false;   ///< the model's fitted calibration row comes right after this one
 };
 
-/// One reference solve: a scene (possibly with another trajectory than its file's) at a mesh level
-/// on chosen samples, cached in `dir` (reference_cache.hpp).
-struct ReferenceSolve {
-  Scene scene;
-  int level = 0;
-  std::vector<std::size_t> indices;
-  std::filesystem::path dir;
-  std::string key_text;
-};
+using ReferenceSolve = StudyReferenceSolve;
 
 struct PlannedScene {
   Scene scene;
@@ -281,21 +273,23 @@ void run_and_write(const std::string& model, const Scene& scene, const TetMesh& 
   write_run(dir, profile, run_manifest(scene, built, mesh, profile, wall));
 }
 
-} // namespace
-
-StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
-                      const StudyExecution& execution) {
-  namespace fs = std::filesystem;
-  if (execution.ranks > 1 && !execution.synchronise)
-    throw std::invalid_argument("run_study: " + std::to_string(execution.ranks) + " ranks need a synchronise function");
-  const auto synchronise = [&](int value) { return execution.ranks > 1 ? execution.synchronise(value) : value; };
-
-  // Plan (every rank the same): scenes, reference solves, model runs, fitted calibrations.
+/// Everything a study runs, planned from its file: the same on every rank and for
+/// study_reference_solves.
+struct StudyPlan {
   std::vector<PlannedScene> scenes;
   std::vector<ReferenceSolve> solves;
   std::vector<ModelRun> model_runs;
   std::vector<FitRun> fit_runs;
-  const bool with_reference = spec.has_reference && reference;
+};
+
+StudyPlan plan_study(const StudySpec& spec, const std::filesystem::path& out, bool reference_wanted = true) {
+  namespace fs = std::filesystem;
+  StudyPlan plan;
+  std::vector<PlannedScene>& scenes = plan.scenes;
+  std::vector<ReferenceSolve>& solves = plan.solves;
+  std::vector<ModelRun>& model_runs = plan.model_runs;
+  std::vector<FitRun>& fit_runs = plan.fit_runs;
+  const bool with_reference = spec.has_reference && reference_wanted;
   const auto plan_solve = [&](const Scene& scene, int level, int samples) {
     ReferenceSolve solve{study_reference_scene(scene, level), level, solved_samples(scene, samples), {}, {}};
     const ReferenceCacheKey key = reference_cache_key(solve.scene, study_reference_settings(spec.reference, level, solve.indices));
@@ -363,6 +357,43 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     }
     scenes.push_back(std::move(planned));
   }
+  return plan;
+}
+
+/// Copies a solve's library entry (reference_library.hpp) into the study's cache when the library
+/// holds one under the solve's key: the same key text, so the same scene, mesh, samples and solver.
+void take_from_library(const std::filesystem::path& library, const ReferenceSolve& solve) {
+  namespace fs = std::filesystem;
+  if (library.empty()) return;
+  const fs::path entry = library / solve.dir.filename();
+  if (!fs::exists(entry / "profile.csv") || !fs::exists(entry / "key.txt") || read_text(entry / "key.txt") != solve.key_text) return;
+  fs::create_directories(solve.dir);
+  for (const char* f : {"manifest.json", "key.txt"})
+    if (fs::exists(entry / f)) fs::copy_file(entry / f, solve.dir / f, fs::copy_options::overwrite_existing);
+  // The profile last: its presence marks the cache entry as complete.
+  write_text(solve.dir / "profile.csv", read_text(entry / "profile.csv"));
+}
+
+} // namespace
+
+StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
+                      const StudyExecution& execution) {
+  namespace fs = std::filesystem;
+  if (execution.ranks > 1 && !execution.synchronise)
+    throw std::invalid_argument("run_study: " + std::to_string(execution.ranks) + " ranks need a synchronise function");
+  const auto synchronise = [&](int value) { return execution.ranks > 1 ? execution.synchronise(value) : value; };
+
+  // Plan (every rank the same): scenes, reference solves, model runs, fitted calibrations.
+  StudyPlan plan = plan_study(spec, out, static_cast<bool>(reference));
+  std::vector<PlannedScene>& scenes = plan.scenes;
+  std::vector<ReferenceSolve>& solves = plan.solves;
+  std::vector<ModelRun>& model_runs = plan.model_runs;
+  std::vector<FitRun>& fit_runs = plan.fit_runs;
+  // A solve the cache lacks and the study's reference library holds, with the same key, is taken
+  // from the library into the cache.
+  if (execution.rank == 0)
+    for (const ReferenceSolve& solve : solves)
+      if (!fs::exists(solve.dir / "profile.csv")) take_from_library(spec.reference.library, solve);
   std::vector<std::size_t> reference_runs; // solves not cached
   for (std::size_t k = 0; k < solves.size(); ++k)
     if (!fs::exists(solves[k].dir / "profile.csv")) reference_runs.push_back(k);
@@ -507,7 +538,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     if (finest) {
       const int finest_level = references.rbegin()->first;
       try {
-        verified.verification = verify_reference(levels, tool);
+        verified.verification = verify_reference(levels, tool, spec.reference.degree + 1.0);
         verified.note = verified.verification ? verified.verification->summary()
                                               : "no GCI available: " + std::to_string(levels.size()) +
                                                     " mesh level(s), solution verification needs 3 ([reference] refinements)";
@@ -533,7 +564,9 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
         if (verified.levels[k] == finest_level) row.profile = verified.profiles[k];
       result.rows.push_back(std::move(row));
     }
-    const std::optional<double> rms_uncertainty = verified.verification ? verified.verification->rms_uncertainty() : std::nullopt;
+    // A model's RMS force error is a norm of its difference to the reference profile: it is set
+    // beside the profile's uncertainty in the same norm.
+    const std::optional<double> rms_uncertainty = verified.verification ? verified.verification->profile_uncertainty() : std::nullopt;
     const std::optional<double> peak_uncertainty = verified.verification ? verified.verification->peak_uncertainty() : std::nullopt;
 
     // The reference's own discretisation error: each coarser level against the finest.
@@ -640,6 +673,26 @@ StudyTable StudyResult::table() const {
                c ? O(r.cost.max) : O(), c ? O(r.cost.rate_allowed()) : O(), r.note});
   }
   return t;
+}
+
+std::vector<StudyReferenceSolve> study_reference_solves(const StudySpec& spec, const std::filesystem::path& out) {
+  return plan_study(spec, out).solves;
+}
+
+int publish_references(const std::vector<StudyReferenceSolve>& solves, const std::filesystem::path& library,
+                       const std::string& command) {
+  namespace fs = std::filesystem;
+  int published = 0;
+  for (const StudyReferenceSolve& solve : solves) {
+    if (!fs::exists(solve.dir / "profile.csv")) continue;
+    const fs::path entry = library / solve.dir.filename();
+    fs::create_directories(entry);
+    for (const char* f : {"manifest.json", "key.txt", "profile.csv"})
+      if (fs::exists(solve.dir / f)) write_text(entry / f, read_text(solve.dir / f));
+    write_text(entry / "command.txt", command + "\n");
+    ++published;
+  }
+  return published;
 }
 
 } // namespace kerf

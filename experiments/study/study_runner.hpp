@@ -107,6 +107,30 @@ struct StudyExecution {
 StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, const ReferenceRunner& reference,
                       const StudyExecution& execution = {});
 
+/// One reference solve a study plans: a scene (possibly with another trajectory than its file's:
+/// a calibration trajectory) at a mesh level on chosen samples, cached in `dir`
+/// (`out/cache/<key directory>`, reference_cache.hpp) with its key's text.
+struct StudyReferenceSolve {
+  Scene scene;
+  int level = 0;
+  std::vector<std::size_t> indices;
+  std::filesystem::path dir;
+  std::string key_text;
+};
+
+/// Every reference solve `spec` plans (each scene's levels, then the calibration trajectories'),
+/// their cache directories under `out`, as run_study plans them.
+std::vector<StudyReferenceSolve> study_reference_solves(const StudySpec& spec, const std::filesystem::path& out);
+
+/// Copies each of `solves` that is in its cache (profile.csv, key.txt, manifest.json — which holds
+/// kerf's version, its git commit and the solve's settings) into `library/<key directory>/`, with
+/// `command.txt` holding `command` (what made it), replacing an entry of the same key; returns how
+/// many. The library
+/// is what a study file's `[reference] library` names: a study takes from it every solve whose key
+/// it holds instead of solving it (docs/studies.md, "Reference library").
+int publish_references(const std::vector<StudyReferenceSolve>& solves, const std::filesystem::path& library,
+                       const std::string& command);
+
 /// The trajectory samples the reference solves: `count` indices evenly spaced over [0, n-1],
 /// first and last included.
 std::vector<std::size_t> reference_sample_indices(std::size_t n, int count);

@@ -81,7 +81,7 @@ StudySpec read_study(const std::filesystem::path& file) {
   }
   if (const toml::table* ref = doc["reference"].as_table()) {
     spec.has_reference = true;
-    allow_only(file, *ref, "reference.", {"degree", "refinements", "scene_refinements", "samples", "linear_solver", "fracture"});
+    allow_only(file, *ref, "reference.", {"degree", "refinements", "scene_refinements", "samples", "linear_solver", "fracture", "library"});
     if (auto d = (*ref)["degree"]) {
       const auto v = d.value<int64_t>();
       if (!v || (*v != 1 && *v != 2)) fail(file, d.node()->source(), "reference.degree", "expected 1 or 2");
@@ -114,6 +114,13 @@ StudySpec read_study(const std::filesystem::path& file) {
         spec.reference.scene_refinements[scene] =
             read_levels(toml::node_view<const toml::node>(&levels), "reference.scene_refinements." + scene);
       }
+    }
+    if (auto l = (*ref)["library"]) {
+      const auto v = l.value<std::string>();
+      if (!v || v->empty()) fail(file, l.node()->source(), "reference.library", "expected a folder, relative to the study file");
+      spec.reference.library = (file.parent_path() / *v).lexically_normal();
+      if (std::filesystem::exists(spec.reference.library) && !std::filesystem::is_directory(spec.reference.library))
+        fail(file, l.node()->source(), "reference.library", "expected a folder, not the file " + spec.reference.library.string());
     }
     if (auto s = (*ref)["samples"]) {
       const auto v = s.value<int64_t>();

@@ -79,6 +79,11 @@ struct StudyReferenceSpec {
   /// Cohesive fracture along the scene's cut_plane (experiments/run/reference_fracture.hpp): "off"
   /// (default, as `kerf reference`), "auto" or "on".
   ReferenceFracture fracture = ReferenceFracture::off;
+  /// The reference library ([reference] library, a folder relative to the study file): solved
+  /// references kept with the study, each in a folder named by its cache key (reference_cache.hpp)
+  /// with its key.txt. A solve whose key the library holds is taken from it instead of solved;
+  /// any other is solved. Empty: none.
+  std::filesystem::path library;
 };
 
 /// A calibration the study fits itself ([[calibrate]]): `model`'s free parameters

@@ -354,6 +354,17 @@ protected:
   fs::path m_dir;
 };
 
+// The three laws by their scene names, and the name each is written back as (the reference cache
+// key's material line).
+TEST_F(SceneReaderTest, MaterialLawsReadByName) {
+  for (const MaterialLaw law : {MaterialLaw::neo_hookean, MaterialLaw::decoupled_neo_hookean, MaterialLaw::st_venant_kirchhoff}) {
+    std::string text = minimal();
+    const std::string from = "law = \"st-venant-kirchhoff\"";
+    text.replace(text.find(from), from.size(), std::string("law = \"") + material_law_name(law) + "\"");
+    EXPECT_EQ(read_scene(write("s.toml", text)).material.law, law) << material_law_name(law);
+  }
+}
+
 TEST_F(SceneReaderTest, SINumbersAndUnitsMixAndDirectionsAreNormalised) {
   const Scene s = read_scene(write("s.toml", minimal()));
   EXPECT_EQ(s.material.law, MaterialLaw::st_venant_kirchhoff);
@@ -452,6 +463,7 @@ TEST_F(SceneReaderTest, RangesAreChecked) {
       {"phenomena = [\"deformation\", \"cutting\"]", "phenomena = []", "scene.phenomena"},
       {"phenomena = [\"deformation\", \"cutting\"]", "phenomena = [\"cutting\", \"cutting\"]", "scene.phenomena[1]"},
       {"name = \"t\"\n", "name = \"\"\n", "scene.name"},
+      {"law = \"st-venant-kirchhoff\"", "law = \"mooney-rivlin\"", "material.law"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.to);

@@ -3,6 +3,7 @@
 // which the procedure must recover exactly) and against the paper's worked example (Table 1).
 
 #include "experiments/study/solution_verification.hpp"
+#include "experiments/study/reference_verification.hpp"
 
 #include <gtest/gtest.h>
 
@@ -115,4 +116,71 @@ TEST(SolutionVerification, TheBandIsTheGciSampleBySample) {
   for (std::size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(u[k], gci_safety_factor * std::abs(fine[k] - a[k]), 1e-14);
   EXPECT_THROW(gci_band_half_width(fine, {1.0}, 2.0, 2.0), std::invalid_argument);
   EXPECT_THROW(gci_band_half_width(fine, medium, 1.0, 2.0), std::invalid_argument);
+}
+
+TEST(SolutionVerification, DifferenceNormsGiveTheProfilesOrderAndUncertainty) {
+  // A profile whose error is C h^p times a fixed shape g: ‖f_h − f‖ = C h^p ‖g‖. With p = 1.5 on
+  // h = 0.4, 0.6, 1.2 (r21 = 1.5, r32 = 2): e21 = C‖g‖ (h2^p − h1^p), e32 = C‖g‖ (h3^p − h2^p), and
+  // the uncertainty Fs e21 / (r21^p − 1) = Fs C‖g‖ h1^p, Fs times the true error of the finest.
+  const double p = 1.5, scale = 0.37, h1 = 0.4, h2 = 0.6, h3 = 1.2;
+  const double e21 = scale * (std::pow(h2, p) - std::pow(h1, p)), e32 = scale * (std::pow(h3, p) - std::pow(h2, p));
+  const DifferenceConvergence c = difference_convergence(h1, h2, h3, e21, e32, 2.0);
+  ASSERT_TRUE(c.usable()) << c.unusable;
+  EXPECT_NEAR(*c.observed_order, p, 1e-10);
+  EXPECT_NEAR(*c.order_used, p, 1e-10);
+  EXPECT_NEAR(*c.uncertainty, gci_safety_factor * scale * std::pow(h1, p), 1e-10);
+}
+
+TEST(SolutionVerification, AnOrderAboveTheFormalOneIsNotTrusted) {
+  // e32 / e21 = 8 on r = 2: p = 3 observed; with the formal order 2 the uncertainty takes 2:
+  // Fs e21 / (2^2 − 1), not Fs e21 / (2^3 − 1) (Roache 1998).
+  const DifferenceConvergence c = difference_convergence(1.0, 2.0, 4.0, 0.1, 0.8, 2.0);
+  ASSERT_TRUE(c.usable()) << c.unusable;
+  EXPECT_NEAR(*c.observed_order, 3.0, 1e-10);
+  EXPECT_DOUBLE_EQ(*c.order_used, 2.0);
+  EXPECT_NEAR(*c.uncertainty, gci_safety_factor * 0.1 / 3.0, 1e-14);
+}
+
+TEST(SolutionVerification, DifferencesThatDoNotShrinkGiveNoUncertainty) {
+  const DifferenceConvergence growing = difference_convergence(1.0, 2.0, 4.0, 0.5, 0.4, 2.0);
+  EXPECT_FALSE(growing.usable());
+  EXPECT_NE(growing.unusable.find("do not shrink"), std::string::npos) << growing.unusable;
+  const DifferenceConvergence same = difference_convergence(1.0, 2.0, 4.0, 0.0, 0.4, 2.0);
+  EXPECT_FALSE(same.usable());
+  EXPECT_THROW(difference_convergence(1.0, 1.0, 4.0, 0.1, 0.2, 2.0), std::invalid_argument);
+  EXPECT_THROW(difference_convergence(1.0, 2.0, 4.0, -0.1, 0.2, 2.0), std::invalid_argument);
+  EXPECT_THROW(difference_convergence(1.0, 2.0, 4.0, 0.1, 0.2, 0.0), std::invalid_argument);
+}
+
+TEST(SolutionVerification, LevelsWhoseRmsAgreeByCoincidenceStillShowTheirProfilesDiffer) {
+  // Two samples per level, h = 1, 2, 4 mm: the finest [3, 4] N and the next [4, 3.0001] N have
+  // the same RMS |F| to 1e-5, so the GCI of RMS |F| is tiny; the profiles differ by 1 N at both
+  // samples. The profile's uncertainty comes from e21 = RMS of the differences = 1 N and
+  // e32 = RMS([2, 2.3]) N: p = log2(e32 / e21), U = Fs e21 / (2^p − 1) — of the order of the
+  // 1 N the levels differ by, not of the RMS values' coincidence.
+  const auto level = [](int k, double h, double f0, double f1) {
+    ForceProfile p;
+    for (const auto& [t, f] : {std::pair{0.0, f0}, std::pair{1.0, f1}}) {
+      ProfileRow r;
+      r.t = t;
+      r.tool = "blade";
+      r.force = Eigen::Vector3d(0.0, 0.0, f);
+      p.rows.push_back(r);
+    }
+    return ReferenceLevel{k, h, p};
+  };
+  const std::vector<ReferenceLevel> levels{level(0, 1e-3, 3.0, 4.0), level(-1, 2e-3, 4.0, 3.0001), level(-2, 4e-3, 6.0, 0.7001)};
+  const auto v = verify_reference(levels, "blade", 2.0);
+  ASSERT_TRUE(v.has_value());
+  ASSERT_TRUE(v->rms.usable()) << v->rms.unusable;
+  EXPECT_LT(*v->rms.gci_fine, 1e-3); // what the RMS's GCI alone would claim
+  ASSERT_TRUE(v->profile.usable()) << v->profile.unusable;
+  EXPECT_NEAR(v->profile.e21, std::sqrt((1.0 + 0.9999 * 0.9999) / 2.0), 1e-12);
+  const double e32 = std::sqrt((4.0 + 2.3 * 2.3) / 2.0);
+  EXPECT_NEAR(v->profile.e32, e32, 1e-12);
+  const double p = std::log2(e32 / v->profile.e21);
+  EXPECT_NEAR(*v->profile.observed_order, p, 1e-9);
+  EXPECT_NEAR(*v->profile_uncertainty(), gci_safety_factor * v->profile.e21 / (std::pow(2.0, p) - 1.0), 1e-9);
+  EXPECT_GT(*v->profile_uncertainty(), 0.5);
+  EXPECT_NE(v->summary().find("on the force profile"), std::string::npos) << v->summary();
 }
