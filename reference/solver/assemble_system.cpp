@@ -231,11 +231,12 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
   if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);
 }
 
+// For the two algebras (algebra.hpp); Newton calls them (newton_raphson.cpp).
 template void FiniteStrainSolver::Impl::assemble<SerialAlgebra>(SerialAlgebra&, const SerialAlgebra::VectorType&, const LoadState&, bool,
-                                                     FiniteStrainSolver::Impl::Assembly<SerialAlgebra::VectorType>&,
+                                                     Assembly<SerialAlgebra::VectorType>&,
                                                      const dealii::AffineConstraints<double>*, SerialAlgebra::VectorType*);
 template void FiniteStrainSolver::Impl::assemble<DistributedAlgebra>(DistributedAlgebra&, const DistributedAlgebra::VectorType&, const LoadState&, bool,
-                                                     FiniteStrainSolver::Impl::Assembly<DistributedAlgebra::VectorType>&,
+                                                     Assembly<DistributedAlgebra::VectorType>&,
                                                      const dealii::AffineConstraints<double>*, DistributedAlgebra::VectorType*);
 
 } // namespace kerf::reference

@@ -167,13 +167,16 @@ void FiniteStrainSolver::Impl::assemble_blade_edge(const VectorType& state, cons
   }
 }
 
-template void FiniteStrainSolver::Impl::assemble_blade_edge<SerialAlgebra::VectorType, SerialAlgebra::MatrixType,
-                                                        FiniteStrainSolver::Impl::Assembly<SerialAlgebra::VectorType>>(
-    const SerialAlgebra::VectorType&, const LoadState&, bool, FiniteStrainSolver::Impl::Assembly<SerialAlgebra::VectorType>&,
-    const dealii::AffineConstraints<double>*, SerialAlgebra::MatrixType&, SerialAlgebra::VectorType*, SerialAlgebra::VectorType&) const;
-template void FiniteStrainSolver::Impl::assemble_blade_edge<DistributedAlgebra::VectorType, DistributedAlgebra::MatrixType,
-                                                        FiniteStrainSolver::Impl::Assembly<DistributedAlgebra::VectorType>>(
-    const DistributedAlgebra::VectorType&, const LoadState&, bool, FiniteStrainSolver::Impl::Assembly<DistributedAlgebra::VectorType>&,
-    const dealii::AffineConstraints<double>*, DistributedAlgebra::MatrixType&, DistributedAlgebra::VectorType*, DistributedAlgebra::VectorType&) const;
+// For the two algebras (algebra.hpp); the assembly calls them (assemble_system.cpp).
+template void FiniteStrainSolver::Impl::assemble_blade_edge(const SerialAlgebra::VectorType&, const LoadState&, bool,
+                                                            Assembly<SerialAlgebra::VectorType>&,
+                                                            const dealii::AffineConstraints<double>*,
+                                                            SerialAlgebra::MatrixType&, SerialAlgebra::VectorType*,
+                                                            SerialAlgebra::VectorType&) const;
+template void FiniteStrainSolver::Impl::assemble_blade_edge(const DistributedAlgebra::VectorType&, const LoadState&, bool,
+                                                            Assembly<DistributedAlgebra::VectorType>&,
+                                                            const dealii::AffineConstraints<double>*,
+                                                            DistributedAlgebra::MatrixType&, DistributedAlgebra::VectorType*,
+                                                            DistributedAlgebra::VectorType&) const;
 
 } // namespace kerf::reference

@@ -194,11 +194,14 @@ CohesiveSummary FiniteStrainSolver::Impl::commit_cohesive(const LoadState& load)
   return summary;
 }
 
-template void FiniteStrainSolver::Impl::assemble_cohesive<SerialAlgebra::VectorType, SerialAlgebra::MatrixType>(
-    const SerialAlgebra::VectorType&, const LoadState&, bool, const dealii::AffineConstraints<double>*, SerialAlgebra::MatrixType&,
-    SerialAlgebra::VectorType*, SerialAlgebra::VectorType&) const;
-template void FiniteStrainSolver::Impl::assemble_cohesive<DistributedAlgebra::VectorType, DistributedAlgebra::MatrixType>(
-    const DistributedAlgebra::VectorType&, const LoadState&, bool, const dealii::AffineConstraints<double>*, DistributedAlgebra::MatrixType&,
-    DistributedAlgebra::VectorType*, DistributedAlgebra::VectorType&) const;
+// For the two algebras (algebra.hpp); the assembly calls them (assemble_system.cpp).
+template void FiniteStrainSolver::Impl::assemble_cohesive(const SerialAlgebra::VectorType&, const LoadState&, bool,
+                                                          const dealii::AffineConstraints<double>*,
+                                                          SerialAlgebra::MatrixType&, SerialAlgebra::VectorType*,
+                                                          SerialAlgebra::VectorType&) const;
+template void FiniteStrainSolver::Impl::assemble_cohesive(const DistributedAlgebra::VectorType&, const LoadState&, bool,
+                                                          const dealii::AffineConstraints<double>*,
+                                                          DistributedAlgebra::MatrixType&, DistributedAlgebra::VectorType*,
+                                                          DistributedAlgebra::VectorType&) const;
 
 } // namespace kerf::reference

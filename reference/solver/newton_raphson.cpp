@@ -282,7 +282,10 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
   return report;
 }
 
-template EquilibriumReport FiniteStrainSolver::Impl::newton<SerialAlgebra>(SerialAlgebra&, const LoadState&, const SerialAlgebra::VectorType&);
-template EquilibriumReport FiniteStrainSolver::Impl::newton<DistributedAlgebra>(DistributedAlgebra&, const LoadState&, const DistributedAlgebra::VectorType&);
+// For the two algebras (algebra.hpp); the load-step driver calls them (finite_strain_solver.cpp).
+template EquilibriumReport FiniteStrainSolver::Impl::newton<SerialAlgebra>(SerialAlgebra&, const LoadState&,
+                                                                 const SerialAlgebra::VectorType&);
+template EquilibriumReport FiniteStrainSolver::Impl::newton<DistributedAlgebra>(DistributedAlgebra&, const LoadState&,
+                                                                 const DistributedAlgebra::VectorType&);
 
 } // namespace kerf::reference

@@ -370,10 +370,12 @@ double FiniteStrainSolver::Impl::dirichlet_constraints(const Algebra& la, const 
   return max(mismatch);
 }
 
-template double FiniteStrainSolver::Impl::dirichlet_constraints<SerialAlgebra>(const SerialAlgebra&, const SerialAlgebra::VectorType&, const LoadState&,
+// For the two algebras (algebra.hpp); Newton calls them (newton_raphson.cpp).
+template double FiniteStrainSolver::Impl::dirichlet_constraints<SerialAlgebra>(const SerialAlgebra&, const SerialAlgebra::VectorType&,
+                                                                       const LoadState&,
                                                                        dealii::AffineConstraints<double>&) const;
 template double FiniteStrainSolver::Impl::dirichlet_constraints<DistributedAlgebra>(const DistributedAlgebra&, const DistributedAlgebra::VectorType&,
-                                                                            const LoadState&,
-                                                                            dealii::AffineConstraints<double>&) const;
+                                                                       const LoadState&,
+                                                                       dealii::AffineConstraints<double>&) const;
 
 } // namespace kerf::reference
