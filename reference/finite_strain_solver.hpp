@@ -12,8 +12,8 @@
 // on its own, the program solves serially (deal.II vectors, UMFPACK) without initialising MPI.
 //
 // This header is plain data + pimpl: it includes no deal.II or PETSc, so the rest of kerf compiles
-// without them (the only translation units that include deal.II are finite_strain_solver.cpp and
-// tangent_solver.cpp in this folder; mpi_processes.cpp includes PETSc).
+// without them (deal.II is included only by the solver's own sources in this folder:
+// finite_strain_solver.cpp, solver/ and tangent_solver.cpp; mpi_processes.cpp includes PETSc).
 
 #include "meshes/tet_mesh.hpp"
 #include "reference/cohesive/cohesive_law.hpp"

@@ -1,0 +1,242 @@
+// The assembly of one Newton iteration (step-44's assemble_system), total Lagrangian: the internal
+// forces f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV of the hyperelastic cells and their tangent
+// K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV (𝔸 = ∂P/∂F), the inertia M a(u) of the
+// Newmark step and the Kelvin–Voigt viscous stress (newmark_dynamics.cpp), the dead-load
+// tractions and the tool's frictionless penalty contact on the boundary faces; then the blade
+// edge pass (blade_edge_pass.cpp) and the cohesive interface (cohesive_interface.cpp). The
+// residual is R = f_int − f_ext (f_ext including the contact forces).
+
+#include "reference/solver/finite_strain_impl.hpp"
+
+#include "reference/material/finite_strain_error.hpp"
+
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/full_matrix.h>
+
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace kerf::reference {
+
+template <class Algebra>
+void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::VectorType& owned_state,
+                                        const LoadState& load, bool with_matrix,
+                                        Assembly<typename Algebra::VectorType>& out,
+                                        const dealii::AffineConstraints<double>* constraints,
+                                        typename Algebra::VectorType* rhs) {
+  typename Algebra::VectorType f_int, f_ext;
+  la.reinit(f_int);
+  la.reinit(f_ext);
+  la.reinit(out.residual);
+  out.contact_on_body.setZero();
+  out.traction_on_body.setZero();
+  out.contact_points = 0;
+  out.contact_area = 0.0;
+  out.max_pressure = 0.0;
+  out.contact_energy = 0.0;
+  if (with_matrix) {
+    la.K = 0.0;
+    *rhs = 0.0;
+  }
+  // An element that fails on one process fails the assembly on every process (after the
+  // collective compress), so that all of them take the same branch of Newton and line search.
+  std::string failure;
+  try {
+    assemble_cells(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_int, f_ext);
+  } catch (const FiniteStrainError& e) {
+    failure = e.what();
+  }
+  out.edge_points = 0;
+  out.edge_length = 0.0;
+  out.max_line_load = 0.0;
+  if (blade_edge) assemble_blade_edge(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_ext);
+  if (with_matrix) {
+    la.K.compress(dealii::VectorOperation::add);
+    rhs->compress(dealii::VectorOperation::add);
+  }
+  f_int.compress(dealii::VectorOperation::add);
+  f_ext.compress(dealii::VectorOperation::add);
+  if (max(failure.empty() ? 0.0 : 1.0) > 0.0)
+    throw FiniteStrainError(failure.empty() ? "finite strain: an element of another process failed" : failure);
+  // The contact and traction tallies of every process's cells.
+  std::array<double, 11> tally{out.contact_on_body.x(), out.contact_on_body.y(), out.contact_on_body.z(),
+                               out.traction_on_body.x(), out.traction_on_body.y(), out.traction_on_body.z(),
+                               static_cast<double>(out.contact_points), out.contact_area,
+                               static_cast<double>(out.edge_points), out.edge_length, out.contact_energy};
+  sum(tally);
+  out.contact_on_body = Eigen::Vector3d(tally[0], tally[1], tally[2]);
+  out.traction_on_body = Eigen::Vector3d(tally[3], tally[4], tally[5]);
+  out.contact_points = static_cast<int>(tally[6]);
+  out.contact_area = tally[7];
+  out.edge_points = static_cast<int>(tally[8]);
+  out.edge_length = tally[9];
+  out.contact_energy = tally[10];
+  out.max_pressure = max(out.max_pressure);
+  out.max_line_load = max(out.max_line_load);
+  out.residual = f_int;
+  out.residual -= f_ext;
+  out.internal_norm = f_int.l2_norm();
+  out.external_norm = f_ext.l2_norm();
+  if (poison_residual) out.residual *= std::numeric_limits<double>::quiet_NaN(); // fault injection (issue 10)
+  if (!std::isfinite(out.residual.l2_norm())) throw FiniteStrainError("finite strain: non-finite residual");
+}
+
+template <class VectorType, class MatrixType, class Tally>
+void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const LoadState& load, bool with_matrix,
+                                              Tally& out, const dealii::AffineConstraints<double>* constraints,
+                                              MatrixType& K, VectorType* rhs, VectorType& f_int,
+                                              VectorType& f_ext) const {
+  const unsigned n = fe->n_dofs_per_cell();
+  const CellGeometry& geo = geometry;
+  dealii::FEFaceValues<3> ffv(*mapping, *fe, *face_quadrature,
+                              dealii::update_values | dealii::update_quadrature_points | dealii::update_JxW_values);
+  const dealii::FEValuesExtractors::Vector disp(0);
+  std::vector<dealii::Tensor<1, 3>> face_u(face_quadrature->size());
+  std::vector<double> cell_u(n);
+  dealii::FullMatrix<double> cell_K(n, n);
+  dealii::Vector<double> cell_int(n), cell_ext(n), cell_rhs(n);
+  std::vector<dealii::types::global_dof_index> local(n);
+  std::vector<unsigned> comp(n);
+  for (unsigned i = 0; i < n; ++i) comp[i] = fe->system_to_component_index(i).first;
+  std::vector<Eigen::Vector3d> gradN(n);
+  std::vector<Eigen::Matrix<double, 9, 1>> AgradN(n);
+  std::vector<double> velocity(n);
+
+  for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue; // distributed: another process assembles it
+    cell->get_dof_indices(local);
+    const std::size_t c_index = cell->active_cell_index();
+    for (unsigned i = 0; i < n; ++i) cell_u[i] = state(local[i]);
+    cell_K = 0.0;
+    cell_int = 0.0;
+    cell_ext = 0.0;
+    const HyperelasticLaw& law = *laws[cell->material_id()];
+    if (dynamics && dynamics->step > 0.0) {
+      // Inertia (Newmark β = 1/4): f_a += Σ_b M_ab a_b(u), a_b = 4/h² (u_b − u_n,b) − 4/h v_n,b − a_n,b,
+      // and ∂f_a/∂u_b = 4/h² M_ab. M_ab = m_ij δ(c_a, c_b), m the cell's scalar mass matrix.
+      const Dynamics& d = *dynamics;
+      const std::vector<double>& m = d.cell_mass[cell->active_cell_index()];
+      const double c = 4.0 / (d.step * d.step);
+      for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = 0; j < n; ++j) {
+          if (comp[i] != comp[j]) continue;
+          const double Mij = m[d.node_of_dof[i] * d.nodes + d.node_of_dof[j]];
+          cell_int(i) += Mij * newmark_acceleration(local[j], state(local[j]));
+          if (with_matrix) cell_K(i, j) += c * Mij;
+        }
+    }
+    // Kelvin–Voigt damping (dynamic step): the Newmark velocity v_{n+1}(u) of the cell's DOFs.
+    const bool damped = dynamics && dynamics->damped && dynamics->step > 0.0 &&
+                        damping[cell->material_id()].retardation_time > 0.0;
+    if (damped)
+      for (unsigned i = 0; i < n; ++i) velocity[i] = newmark_velocity(local[i], state(local[i]));
+    for (unsigned q = 0; q < geo.points; ++q) {
+      for (unsigned i = 0; i < n; ++i) gradN[i] = Eigen::Map<const Eigen::Vector3d>(geo.gradient(c_index, q, geo.node_of_dof[i]));
+      // F = I + Grad u = I + Σ_a u_a e_c ⊗ Grad N_a (total Lagrangian: gradients with respect to
+      // the reference configuration)
+      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+      for (unsigned i = 0; i < n; ++i) F.row(comp[i]) += cell_u[i] * gradN[i].transpose();
+      const double JxW = geo.JxW[c_index * geo.points + q];
+      // The residual-only assemblies of the line search need P = F S alone (the same bits).
+      StressTangent st;
+      if (with_matrix) {
+        Eigen::Matrix3d S;
+        Tensor4 C4;
+        law.second_piola_and_tangent(F, S, C4);
+        st = first_piola_and_tangent(F, S, C4);
+      } else {
+        st.first_piola = F * law.second_piola(F);
+      }
+      if (damped) {
+        // Ḟ = Grad v = Σ_a v_a e_c ⊗ Grad N_a; P += P_v(F, Ḟ), 𝔸 += ∂P_v/∂F with ∂Ḟ/∂F = γ/(βh) = 2/h.
+        Eigen::Matrix3d F_rate = Eigen::Matrix3d::Zero();
+        for (unsigned i = 0; i < n; ++i) F_rate.row(comp[i]) += velocity[i] * gradN[i].transpose();
+        const StressTangent sv = kelvin_voigt_stress(damping[cell->material_id()], F, F_rate, 2.0 / dynamics->step);
+        st.first_piola += sv.first_piola;
+        if (with_matrix) st.tangent += sv.tangent;
+      }
+      // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
+      for (unsigned i = 0; i < n; ++i) cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
+      if (!with_matrix) continue;
+      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV; 𝔸 of a hyperelastic law has the
+      // major symmetry 𝔸_iJkL = 𝔸_kLiJ, so K is symmetric: its upper triangle here, the lower one
+      // mirrored below (the Kelvin–Voigt tangent has no such symmetry: then every entry).
+      for (unsigned j = 0; j < n; ++j) AgradN[j] = st.tangent.middleCols<3>(3 * comp[j]) * gradN[j];
+      for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = damped ? 0 : i; j < n; ++j)
+          cell_K(i, j) += gradN[i].dot(AgradN[j].segment<3>(3 * comp[i])) * JxW;
+    }
+    if (with_matrix && !damped)
+      for (unsigned i = 0; i < n; ++i)
+        for (unsigned j = 0; j < i; ++j) cell_K(i, j) = cell_K(j, i);
+
+    // Tractions and contact on boundary faces.
+    for (const unsigned f : cell->face_indices()) {
+      if (!cell->face(f)->at_boundary()) continue;
+      const auto id = cell->face(f)->boundary_id();
+      Eigen::Vector3d traction_sum = Eigen::Vector3d::Zero();
+      const Eigen::Vector3d* traction = nullptr;
+      for (const auto& [group, t] : tractions)
+        if (in_group(id, group)) {
+          traction_sum += t;
+          traction = &traction_sum;
+        }
+      if (traction == nullptr && !tool) continue;
+      ffv.reinit(cell, f);
+      if (tool) ffv[disp].get_function_values(state, face_u);
+      const Eigen::Vector3d side = crack_side(cell, f);
+      for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
+        const double JxW = ffv.JxW(q);
+        Eigen::Vector3d t = Eigen::Vector3d::Zero();
+        if (traction != nullptr) {
+          t += load.load_factor * *traction;
+          out.traction_on_body += load.load_factor * *traction * JxW;
+        }
+        Eigen::Matrix3d dt_dx = Eigen::Matrix3d::Zero();
+        if (tool) {
+          const Eigen::Vector3d x = to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
+          const ToolContactPoint c = tool_contact(*tool, load.tool_position, x, side);
+          if (c.inside) {
+            // t_c = ε_N p n (per unit reference area), p = −g
+            const Eigen::Vector3d tc = penalty * c.penetration * c.normal;
+            t += tc;
+            out.contact_on_body += tc * JxW;
+            ++out.contact_points;
+            out.contact_area += JxW;
+            out.max_pressure = std::max(out.max_pressure, penalty * c.penetration);
+            // Penalty energy ½ ε_N p² per reference area (its derivative is the traction above).
+            out.contact_energy += 0.5 * penalty * c.penetration * c.penetration * JxW;
+            // ∂t_c/∂x = ε_N (−n⊗n + p ∂n/∂x)
+            dt_dx = penalty * (-c.normal * c.normal.transpose() + c.penetration * c.normal_derivative);
+          }
+        }
+        for (unsigned i = 0; i < n; ++i) {
+          const double Ni = ffv.shape_value_component(i, q, comp[i]);
+          if (Ni == 0.0) continue;
+          cell_ext(i) += Ni * t[comp[i]] * JxW;
+          if (with_matrix && tool)
+            for (unsigned j = 0; j < n; ++j)
+              cell_K(i, j) -= Ni * dt_dx(comp[i], comp[j]) * ffv.shape_value_component(j, q, comp[j]) * JxW;
+        }
+      }
+    }
+    f_int.add(local, cell_int);
+    f_ext.add(local, cell_ext);
+    if (with_matrix) {
+      for (unsigned i = 0; i < n; ++i) cell_rhs(i) = cell_ext(i) - cell_int(i);
+      constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
+    }
+  }
+  if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);
+}
+
+// For the two algebras (algebra.hpp); Newton calls them (newton_raphson.cpp).
+template void FiniteStrainSolver::Impl::assemble<SerialAlgebra>(SerialAlgebra&, const SerialAlgebra::VectorType&, const LoadState&, bool,
+                                                     Assembly<SerialAlgebra::VectorType>&,
+                                                     const dealii::AffineConstraints<double>*, SerialAlgebra::VectorType*);
+template void FiniteStrainSolver::Impl::assemble<DistributedAlgebra>(DistributedAlgebra&, const DistributedAlgebra::VectorType&, const LoadState&, bool,
+                                                     Assembly<DistributedAlgebra::VectorType>&,
+                                                     const dealii::AffineConstraints<double>*, DistributedAlgebra::VectorType*);
+
+} // namespace kerf::reference

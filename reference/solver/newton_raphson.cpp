@@ -1,0 +1,291 @@
+// Newton–Raphson for one load (step-44's solve_nonlinear_timestep): K du = −R with the Dirichlet
+// increment imposed through the constraints, a backtracking line search on the free residual,
+// limited-memory BFGS steps between tangents (Matthies & Strang 1979) where they are allowed, the
+// convergence test |R_free| <= rel (|f_int| + |f_ext|) + abs, and after convergence the support
+// reactions and the commit of the cohesive interface and the Newmark state.
+
+#include "reference/solver/finite_strain_impl.hpp"
+
+#include "reference/material/finite_strain_error.hpp"
+
+#include <chrono>
+#include <limits>
+#include <type_traits>
+
+namespace kerf::reference {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+} // namespace
+
+template <class Algebra>
+EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState& load,
+                                                   const typename Algebra::VectorType& start) {
+  using VectorType = typename Algebra::VectorType;
+  constexpr bool serial_algebra = std::is_same_v<VectorType, dealii::Vector<double>>;
+  Impl& m = *this;
+  EquilibriumReport report;
+  // `assembly` (with la.K, `rhs` and `constraints` when `with_tangent`) is the assembly of the
+  // current state la.u when `assembled`. A Newton step assembles its full step (α = 1) with the
+  // tangent, so that when it is accepted the next Newton step starts from it.
+  Impl::Assembly<VectorType> assembly, full, trial;
+  VectorType rhs, full_rhs, du;
+  la.reinit(rhs);
+  la.reinit(full_rhs);
+  la.reinit(du);
+  dealii::AffineConstraints<double> constraints, full_constraints;
+  double mismatch = 0.0;
+  bool assembled = false, with_tangent = false;
+  // Quasi-Newton (SolverSettings::quasi_newton; serial direct solver): steps with the last
+  // factorised tangent K₀ corrected by the BFGS updates of the steps since (limited memory, the
+  // two-loop recursion with H₀ = K₀⁻¹; Matthies & Strang 1979, Nocedal 1980). A full Newton step
+  // (tangent assembled and factorised) is taken when a Dirichlet increment is pending, when no
+  // factorisation exists, and after a quasi-Newton step that reduced |R| by less than half, did
+  // not reduce it, or used up the updates.
+  // Contact and a cohesive interface change the tangent abruptly (points enter and leave the
+  // contact set, the interface softens): there the updates converge slowly, and full Newton is used.
+  // Every solve starts with a Newton step (FEBio's "reform each time step"), so that a solve
+  // depends on its start state alone (a run resumed from a checkpoint repeats it bit for bit).
+  const bool quasi_newton_allowed = serial_algebra && m.settings.quasi_newton && !m.tool && !m.cohesive_law &&
+                                    m.linear->kind() == TangentSolver::Kind::direct;
+  bool newton_next = true;
+  std::vector<VectorType> S, Y; // the steps s = Δu and residual changes y = ΔR of the updates
+  std::vector<double> rho;      // 1 / (yᵀ s)
+  constexpr std::size_t max_updates = 10;
+  // Fault injection: asked once per iteration (the full step's assembly asks for the next one).
+  int fault_asked = -1;
+  bool fault_answer = false;
+  auto fault = [&](int it) {
+    if (!m.settings.residual_fault) return false;
+    if (fault_asked != it) {
+      fault_asked = it;
+      fault_answer = m.settings.residual_fault(load, it);
+    }
+    m.fault_fired = m.fault_fired || fault_answer;
+    return fault_answer;
+  };
+  // A cohesive interface whose points switch between loading and unloading can make the
+  // consistent Newton iteration cycle; after a third of the allowed iterations the secant
+  // interface tangent takes over (slower, but it does not cycle). It changes the tangent only.
+  auto secant = [&](int it) { return m.cohesive_law.has_value() && it >= m.settings.max_newton_iterations / 3; };
+  auto fail = [&](std::string why) {
+    la.u = start;
+    report.converged = false;
+    report.failure = std::move(why);
+    return report;
+  };
+  try {
+    for (int it = 0;; ++it) {
+      auto t0 = Clock::now();
+      if (!assembled) {
+        mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
+        m.cohesive_secant = secant(it);
+        m.poison_residual = fault(it);
+        with_tangent = newton_next || mismatch > 0.0;
+        m.assemble(la, la.u, load, with_tangent, assembly, with_tangent ? &constraints : nullptr,
+                   with_tangent ? &rhs : nullptr);
+        m.poison_residual = false;
+        report.assembly_seconds += seconds_since(t0);
+      }
+      assembled = false;
+      const double r = m.free_norm(assembly.residual, la.free_mask);
+      report.residual_history.push_back(r);
+      const double scale = assembly.internal_norm + assembly.external_norm;
+      const double tol = m.settings.relative_tolerance * scale + m.settings.absolute_tolerance;
+      const double u_scale = std::max(la.u.linfty_norm(), 1e-300);
+      if (r <= tol && mismatch <= 1e-12 * u_scale + 1e-300) {
+        report.converged = true;
+        break;
+      }
+      if (it >= m.settings.max_newton_iterations)
+        return fail("no convergence in " + std::to_string(m.settings.max_newton_iterations) + " Newton iterations");
+      const bool newton_step = newton_next || mismatch > 0.0 || !quasi_newton_allowed;
+      if (newton_step && !with_tangent) {
+        // The state's residual came from a line search: its tangent is assembled now.
+        t0 = Clock::now();
+        m.cohesive_secant = secant(it);
+        m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
+        report.assembly_seconds += seconds_since(t0);
+      }
+      t0 = Clock::now();
+      if (newton_step) {
+        report.linear_iterations += m.linear->solve(la.K, du, rhs);
+        constraints.distribute(du);
+        ++report.factorizations;
+        S.clear();
+        Y.clear();
+        rho.clear();
+      } else if constexpr (serial_algebra) {
+        // du = −H R over the free DOFs: the two-loop recursion around K₀⁻¹.
+        VectorType q = assembly.residual;
+        q.scale(la.free_mask);
+        q *= -1.0;
+        std::vector<double> alpha_k(S.size());
+        for (std::size_t k = S.size(); k-- > 0;) {
+          alpha_k[k] = rho[k] * (S[k] * q);
+          q.add(-alpha_k[k], Y[k]);
+        }
+        m.linear->solve_factorized(du, q);
+        du.scale(la.free_mask);
+        for (std::size_t k = 0; k < S.size(); ++k) {
+          const double beta = rho[k] * (Y[k] * du);
+          du.add(alpha_k[k] - beta, S[k]);
+        }
+      }
+      report.linear_solve_seconds += seconds_since(t0);
+      ++report.newton_iterations;
+      // Backtracking line search on the free residual: the first α in 1, ½, … (6 tries) that keeps
+      // every element valid and reduces |R|, else the valid α with the smallest |R|. While a
+      // Dirichlet increment is pending the residual is no merit function (it starts at zero and
+      // must grow with the imposed displacement): then the largest valid α is taken.
+      const VectorType base = la.u;
+      double best_alpha = 0.0, best_r = std::numeric_limits<double>::infinity();
+      bool full_valid = false, full_tangent = false;
+      double full_mismatch = 0.0;
+      for (double alpha = 1.0; alpha > 1.0 / 64.0; alpha *= 0.5) {
+        la.u = base;
+        la.u.add(alpha, du);
+        Impl::Assembly<VectorType>& a = alpha == 1.0 ? full : trial;
+        t0 = Clock::now();
+        if (alpha == 1.0) {
+          // The full step, assembled as the next iteration would (its constraints, fault; the
+          // tangent when this step is a Newton step, whose successor is likely one too).
+          full_mismatch = m.dirichlet_constraints(la, la.u, load, full_constraints);
+          m.cohesive_secant = secant(it + 1);
+          const bool poisoned = fault(it + 1);
+          m.poison_residual = poisoned;
+          full_tangent = newton_step || !quasi_newton_allowed;
+          try {
+            m.assemble(la, la.u, load, full_tangent, full, full_tangent ? &full_constraints : nullptr,
+                       full_tangent ? &full_rhs : nullptr);
+          } catch (const FiniteStrainError&) {
+            m.poison_residual = false;
+            report.assembly_seconds += seconds_since(t0);
+            if (poisoned) throw FiniteStrainError("finite strain: non-finite residual");
+            continue;
+          }
+          m.poison_residual = false;
+          full_valid = true;
+        } else {
+          m.cohesive_secant = secant(it);
+          try {
+            m.assemble(la, la.u, load, false, trial, nullptr, nullptr);
+          } catch (const FiniteStrainError&) {
+            report.assembly_seconds += seconds_since(t0);
+            continue;
+          }
+        }
+        report.assembly_seconds += seconds_since(t0);
+        const double rt = m.free_norm(a.residual, la.free_mask);
+        if (rt < best_r) {
+          best_r = rt;
+          best_alpha = alpha;
+        }
+        if (mismatch > 0.0 || rt <= (1.0 - 1e-4 * alpha) * r || rt <= tol) {
+          best_alpha = alpha;
+          break;
+        }
+      }
+      if (!newton_step && !(best_r < r)) {
+        // The quasi-Newton direction does not reduce |R|: back to the state, a Newton step next.
+        la.u = base;
+        newton_next = true;
+        assembled = true; // the residual is still the state's (its tangent is assembled above)
+        with_tangent = false;
+        continue;
+      }
+      if (best_alpha == 0.0) return fail("every line-search step inverts an element");
+      la.u = base;
+      la.u.add(best_alpha, du);
+      if constexpr (serial_algebra) {
+        if (quasi_newton_allowed) {
+          // The BFGS update of this step, when the accepted state's residual is at hand: s = Δu,
+          // y = ΔR over the free DOFs, kept while yᵀ s > 0 (the curvature condition).
+          const Impl::Assembly<VectorType>* accepted =
+              best_alpha == 1.0 ? (full_valid ? &full : nullptr) : &trial;
+          const bool last_trial_is_best = best_alpha == 1.0 || best_r == m.free_norm(trial.residual, la.free_mask);
+          if (accepted != nullptr && last_trial_is_best) {
+            VectorType s = du;
+            s *= best_alpha;
+            s.scale(la.free_mask);
+            VectorType y = accepted->residual;
+            y -= assembly.residual;
+            y.scale(la.free_mask);
+            const double ys = y * s;
+            if (ys > 0.0) {
+              S.push_back(std::move(s));
+              Y.push_back(std::move(y));
+              rho.push_back(1.0 / ys);
+            }
+          }
+          newton_next = !(best_r <= 0.5 * r) || S.size() >= max_updates;
+        }
+      }
+      if (best_alpha == 1.0 && full_valid) {
+        std::swap(assembly, full);
+        if (full_tangent) {
+          rhs.swap(full_rhs);
+          std::swap(constraints, full_constraints);
+        } else {
+          constraints.clear(); // residual only: constraints are rebuilt if a Newton step follows
+          full_mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
+        }
+        mismatch = full_mismatch;
+        with_tangent = full_tangent;
+        assembled = true;
+      } else if (!newton_step || quasi_newton_allowed) {
+        // A shortened step: the last trial is the accepted state's residual when it was the best.
+        if (best_alpha < 1.0 && best_r == m.free_norm(trial.residual, la.free_mask)) {
+          std::swap(assembly, trial);
+          mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
+          with_tangent = false; // a Newton step next assembles the tangent at the loop's top
+          assembled = true;
+        }
+      }
+    }
+  } catch (const FiniteStrainError& e) {
+    m.poison_residual = false;
+    return fail(e.what());
+  } catch (const std::exception& e) { // PETSc/UMFPACK errors (deal.II exceptions are std::exception)
+    return fail(std::string("linear solver: ") + e.what());
+  }
+  // Reactions: the residual R on the Dirichlet DOFs is the force the supports put on the body;
+  // the reaction of boundary b (body on support) is −Σ R over the Dirichlet DOFs assigned to b.
+  report.boundary_reactions.resize(m.boundaries.size());
+  for (std::size_t b = 0; b < m.boundaries.size(); ++b) report.boundary_reactions[b].surface = m.boundaries[b].surface;
+  for (const auto& d : m.dirichlet)
+    if (la.owns(d.index))
+      report.boundary_reactions[static_cast<std::size_t>(d.boundary)].force[d.component] -= assembly.residual[d.index];
+  for (BoundaryReaction& b : report.boundary_reactions) {
+    m.sum(std::span<double>(b.force.data(), 3));
+    report.support_reaction += b.force;
+  }
+  if (m.cohesive_law) report.cohesive = m.commit_cohesive(load);
+  if (m.dynamics) {
+    if constexpr (std::is_same_v<VectorType, dealii::Vector<double>>) report.kinetic_energy = m.commit_dynamics(la.u);
+    report.damping_dissipation = m.dynamics->damping_dissipation;
+  }
+  m.committed_time = load.time;
+  report.tool_force = -assembly.contact_on_body;
+  report.traction_resultant = assembly.traction_on_body;
+  report.force_imbalance = report.traction_resultant - report.tool_force - report.support_reaction;
+  report.edge_contact_points = assembly.edge_points;
+  report.edge_contact_length = assembly.edge_length;
+  report.max_edge_line_load = assembly.max_line_load;
+  report.contact_points = assembly.contact_points;
+  report.contact_area = assembly.contact_area;
+  report.max_contact_pressure = assembly.max_pressure;
+  report.contact_energy = assembly.contact_energy;
+  return report;
+}
+
+// For the two algebras (algebra.hpp); the load-step driver calls them (finite_strain_solver.cpp).
+template EquilibriumReport FiniteStrainSolver::Impl::newton<SerialAlgebra>(SerialAlgebra&, const LoadState&,
+                                                                 const SerialAlgebra::VectorType&);
+template EquilibriumReport FiniteStrainSolver::Impl::newton<DistributedAlgebra>(DistributedAlgebra&, const LoadState&,
+                                                                 const DistributedAlgebra::VectorType&);
+
+} // namespace kerf::reference
