@@ -71,11 +71,13 @@ void run_study_command(const StudyOptions& o) {
                       "` (the README's first command); do not edit by hand.\n\n" + spec.description + "\n\n" +
                       table.markdown() +
                       "\nErrors are against the finest reference level. Each scene's first row is that reference, its "
-                      "note the solution verification of its three finest mesh levels (Celik et al. 2008: observed "
-                      "order p, Richardson-extrapolated value, GCI as its relative uncertainty; `" +
+                      "note the solution verification of its three finest mesh levels: the uncertainty of the force "
+                      "profile from the RMS of the differences between levels (its observed order, capped at the "
+                      "elements' formal order, and Roache's GCI in that norm), then Celik et al. 2008's observed "
+                      "order, Richardson-extrapolated value and GCI of RMS |F| and of peak |F| (docs/studies.md; `" +
                       (out / "verification.md").string() +
                       "`), or why there is none; the other `reference L<k>` rows are coarser levels against the "
-                      "finest. An error smaller than the reference's uncertainty reads \"below reference "
+                      "finest. An RMS force error smaller than the profile's uncertainty reads \"below reference "
                       "uncertainty\": the reference cannot tell it from zero. Each model is "
                       "scored over the phases it represents: on all of the reference's samples unless its note says "
                       "which; a `not run:` note says why a model of the study has no numbers on a scene. Costs are wall "
