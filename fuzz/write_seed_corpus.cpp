@@ -77,7 +77,7 @@ void write_quantity_seeds(const fs::path& scene_file, const fs::path& out, std::
   for (const std::string& s : strings) {
     if (!written.insert(s).second) continue; // one seed per distinct text
     std::uint8_t dimension = 0;
-    for (int d = 0; d <= static_cast<int>(Dimension::viscosity); ++d) {
+    for (int d = 0; d <= static_cast<int>(Dimension::stiffness_per_area); ++d) {
       try {
         parse_quantity(s, static_cast<Dimension>(d));
         dimension = static_cast<std::uint8_t>(d);

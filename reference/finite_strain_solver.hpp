@@ -69,6 +69,19 @@ struct DisplacementBoundary {
   std::array<bool, 3> components{true, true, true}; ///< prescribed: which components are fixed
 };
 
+/// An elastic foundation (a Robin condition) on a named TetMesh surface group: the surface is held
+/// by a compliant layer to an anchor that moves by the prescribed displacement d(X, load factor).
+/// The layer puts the traction t = k (d − u) per unit reference area on the body (energy
+/// ½ k ∫ |u − d|² dA), linear in u: its tangent is k times the surface "mass" matrix ∫ N_a N_b dA
+/// on each component. A stylus that grasps the surface through an adhesive layer of finite
+/// stiffness (docs/scenes.md "Grasp"); k → ∞ is the rigid tie (a prescribed DisplacementBoundary).
+struct ElasticFoundation {
+  std::string surface;
+  double stiffness = 0.0; ///< k [N/m^3] > 0: traction per unit reference area per metre of stretch
+  /// The anchor's displacement [m] at reference point X [m] and load factor in [0, 1].
+  std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double load)> displacement;
+};
+
 /// A dead-load traction: a uniform traction per unit reference area on a named surface whose
 /// resultant is `load factor × total_force` [N], direction fixed in space (as in the code gallery's
 /// Cook's membrane).
@@ -97,6 +110,7 @@ struct FiniteStrainProblem {
   std::vector<MaterialRegion> materials; ///< first matching region wins; every tet needs one
   std::vector<DisplacementBoundary> displacement_boundaries;
   std::vector<TractionBoundary> tractions;
+  std::vector<ElasticFoundation> foundations; ///< compliant grasps (elastic foundations)
   std::optional<RigidToolShape> tool;    ///< rigid tool in frictionless penalty contact
   std::optional<CohesiveInterfaceSpec> cohesive; ///< crack path held by a cohesive law
 };
@@ -215,8 +229,14 @@ struct EquilibriumReport {
   /// boundaries counts for the first bonded/prescribed one (else the first sliding one), so the
   /// entries sum to `support_reaction`.
   std::vector<BoundaryReaction> boundary_reactions;
-  /// Global balance of the body: traction_resultant − tool_force − support_reaction [N]; zero at
-  /// equilibrium up to the free-DOF residual (Newton's third law: the body is at rest).
+  /// One entry per FiniteStrainProblem::foundations, in that order: the force of the body on the
+  /// foundation's anchor, −∫ k (d − u) dA [N] (the same sign as a reaction: body on its holder).
+  std::vector<Eigen::Vector3d> foundation_forces;
+  /// Energy stored in the elastic foundations, ½ k ∫ |u − d|² dA summed over them [J].
+  double foundation_energy = 0.0;
+  /// Global balance of the body: traction_resultant − tool_force − support_reaction − Σ
+  /// foundation_forces [N]; zero at equilibrium up to the free-DOF residual (Newton's third law:
+  /// the body is at rest).
   Eigen::Vector3d force_imbalance = Eigen::Vector3d::Zero();
   CohesiveSummary cohesive; ///< the interface after this solve (converged solves only)
   int contact_points = 0;    ///< boundary quadrature points inside the tool

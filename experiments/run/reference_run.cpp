@@ -62,7 +62,8 @@ namespace {
 /// grasps the surface), the physical surface `grasp_surface` of the mesh (scene_mesh: a region of
 /// the geometry, the same whatever the mesh): adds the tie group `tie_name` of its triangles and
 /// the prescribed displacement u = p(λ T) − p(0) (the tool displacement since its start, λ the load
-/// factor) to `p`, and returns the coupling. A grasping stylus must start touching the body.
+/// factor) to `p` — or, with a grasp stiffness k, the elastic foundation t = k (d − u) towards that
+/// displacement d — and returns the coupling. A grasping stylus must start touching the body.
 ReferenceToolCoupling tie_stylus(const Scene& scene, const TetMesh& mesh, const Tool& tool,
                                  const std::vector<Eigen::Vector3d>& positions, const std::vector<double>& times,
                                  const std::string& grasp_surface, const std::string& tie_name, FiniteStrainProblem& p) {
@@ -93,13 +94,18 @@ ReferenceToolCoupling tie_stylus(const Scene& scene, const TetMesh& mesh, const 
   auto path = std::make_shared<const std::vector<Eigen::Vector3d>>(positions);
   auto at = std::make_shared<const std::vector<double>>(times);
   const double T = times.back();
+  auto tool_displacement = [path, at, T](const Eigen::Vector3d&, double load) -> Eigen::Vector3d {
+    return position_at(*path, *at, load * T) - path->front();
+  };
+  if (tool.grasp_stiffness) {
+    // A compliant grasp: the disc is held to the tool by an elastic layer, t = k (d − u).
+    c.grasp_stiffness = *tool.grasp_stiffness;
+    c.foundation = static_cast<int>(p.foundations.size());
+    p.foundations.push_back({tie_name, *tool.grasp_stiffness, tool_displacement});
+    return c;
+  }
   c.boundary = static_cast<int>(p.displacement_boundaries.size());
-  p.displacement_boundaries.push_back(
-      {tie_name, DisplacementBoundary::Kind::prescribed,
-       [path, at, T](const Eigen::Vector3d&, double load) -> Eigen::Vector3d {
-         return position_at(*path, *at, load * T) - path->front();
-       },
-       {true, true, true}});
+  p.displacement_boundaries.push_back({tie_name, DisplacementBoundary::Kind::prescribed, tool_displacement, {true, true, true}});
   return c;
 }
 
@@ -392,7 +398,11 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     for (const ReferenceTool& tool : rp.tools) {
       Eigen::Vector3d f = step.tool_force;
       bool touches = step.equilibrium.contact_points + step.equilibrium.edge_contact_points > 0;
-      if (is_tied(tool)) {
+      if (is_tied(tool) && tool.coupling.foundation >= 0) {
+        // A compliant grasp: the force of the body on its layer, −∫ k (d − u) dA (not a support).
+        f = step.equilibrium.foundation_forces.at(static_cast<std::size_t>(tool.coupling.foundation));
+        touches = f.norm() > 0.0;
+      } else if (is_tied(tool)) {
         f = step.equilibrium.boundary_reactions.at(static_cast<std::size_t>(tool.coupling.boundary)).force;
         support -= f;
         touches = f.norm() > 0.0;
@@ -452,7 +462,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     for (const Eigen::Vector3d& f : tool_forces) peak_force = std::max(peak_force, f.norm());
     previous_interface = interface;
     energy.add_sample(tool_positions, forces_on_body, solver.strain_energy(), step.equilibrium.cohesive,
-                      step.equilibrium.contact_energy, solver.kinetic_energy(), solver.damping_dissipation());
+                      step.equilibrium.contact_energy + step.equilibrium.foundation_energy, solver.kinetic_energy(), solver.damping_dissipation());
     for (std::size_t j = 0; j < rp.tools.size(); ++j) {
       ProfileRow row;
       row.t = rp.times[k];
@@ -551,6 +561,7 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
     if (is_tied(tool)) {
       t["tied_nodes"] = tool.coupling.tied_nodes;
       t["tied_triangles"] = tool.coupling.tied_triangles.size();
+      if (tool.coupling.foundation >= 0) t["grasp_stiffness_N_per_m3"] = tool.coupling.grasp_stiffness;
       t["contact_point_m"] = vec_json(tool.coupling.contact_point);
     }
     tools_json.push_back(t);

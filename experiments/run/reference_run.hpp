@@ -82,7 +82,11 @@ struct ReferenceToolCoupling {
   Eigen::Vector3d contact_point = Eigen::Vector3d::Zero(); ///< tied: the body point first touched [m]
   std::vector<int> tied_triangles; ///< tied: rows of the grasp surface group (scene_mesh.hpp) tied to the stylus
   std::size_t tied_nodes = 0;      ///< tied: distinct mesh nodes of those triangles
-  int boundary = -1; ///< tied: index of its tie in FiniteStrainProblem::displacement_boundaries
+  int boundary = -1; ///< tied rigidly: index of its tie in FiniteStrainProblem::displacement_boundaries
+  /// tied through a compliant layer (Tool::grasp_stiffness): k [N/m^3] (0: rigid), and the index of
+  /// its elastic foundation in FiniteStrainProblem::foundations (−1: rigid).
+  double grasp_stiffness = 0.0;
+  int foundation = -1;
 };
 
 /// One scene tool in the reference: how it is coupled, and its reference point at each sample.
@@ -104,7 +108,9 @@ struct ReferenceProblem {
 /// penalty contact, or — a sphere whose start touches the body and whose trajectory never moves
 /// towards it (clay_pull) — tied: the `top` triangles whose three nodes lie within the sphere
 /// radius of the first contact point (if none, those with at least one such node) get the
-/// prescribed displacement u = p(t) − p(0), the tool displacement since contact. Several tools
+/// prescribed displacement u = p(t) − p(0), the tool displacement since contact, or, with a
+/// Tool::grasp_stiffness k, an elastic foundation t = k (d − u) towards d = p(t) − p(0) (a
+/// compliant grasp; reference::ElasticFoundation). Several tools
 /// (clay_tear: two hands pulling) are coupled only as tied styluses, each with its own tie group
 /// `stylus_tie_<name>`. Throws std::invalid_argument for several tools of which one is not a tied
 /// stylus, tools on different time lines, or a tied tool without a `top` surface. The load factor
@@ -114,7 +120,8 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh);
 /// Runs the reference on the scene (see file comment) and returns the profile: one row per tool per
 /// solved sample (t, tool position, force of the body on the tool, mode no-contact when the tool force is
 /// zero (tied) / no contact point (penalty) else deformation-1, crack_extent 0, cost_s = solve
-/// seconds). The tool force of a tied tool is the reaction on the tied nodes. If the load path
+/// seconds). The tool force of a tied tool is the reaction on the tied nodes (a compliant grasp:
+/// the force of the body on its layer, −∫ k (d − u) dA). If the load path
 /// stops (cut-backs exhausted), returns the profile up to the last converged sample and records
 /// the stop message in the manifest. Writes dir/profile.csv, dir/manifest.json, fields and
 /// checkpoints; prints a progress line per sample on stderr. Throws std::invalid_argument on bad

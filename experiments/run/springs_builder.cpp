@@ -240,6 +240,13 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
   p["damping_time_s"] = net.damping_time;
   p["volume_term"] = id.stiffness.volume_modulus > 0.0;
   p["grasp_radius_m"] = setup.grasp_radius > 0.0 ? nlohmann::json(setup.grasp_radius) : nlohmann::json("tip radius + h/2");
+  // The network attaches the grasped nodes rigidly; a scene's compliant grasp (Tool::grasp_stiffness,
+  // the reference's elastic foundation) is not represented: say so beside the results.
+  for (const Tool& t : scene.tools)
+    if (t.grasp_stiffness) {
+      p["grasp"] = "rigid: the scene's grasp_stiffness is not represented by the network";
+      break;
+    }
   p["explicit_stability_limit_s"] = model->stability_limit();
   std::vector<int> attached;
   for (int t = 0; t < model->tool_count(); ++t) attached.push_back(model->attached_nodes(t));

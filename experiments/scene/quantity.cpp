@@ -82,6 +82,12 @@ constexpr std::array units{
   UnitSpelling{"mPa s", Dimension::viscosity, 1e-3},
   UnitSpelling{"mPa*s", Dimension::viscosity, 1e-3},
   UnitSpelling{"mPa.s", Dimension::viscosity, 1e-3},
+  // stiffness per area [N/m^3] = pressure per length [Pa/m]
+  UnitSpelling{"N/m^3", Dimension::stiffness_per_area, 1.0},
+  UnitSpelling{"N/mm^3", Dimension::stiffness_per_area, 1e9},
+  UnitSpelling{"Pa/m", Dimension::stiffness_per_area, 1.0},
+  UnitSpelling{"kPa/mm", Dimension::stiffness_per_area, 1e6},
+  UnitSpelling{"MPa/mm", Dimension::stiffness_per_area, 1e9},
 };
 // clang-format on
 
@@ -105,6 +111,7 @@ std::string_view noun(Dimension d) {
   case Dimension::force: return "a force";
   case Dimension::force_per_length: return "a force per length";
   case Dimension::viscosity: return "a viscosity";
+  case Dimension::stiffness_per_area: return "a stiffness per area";
   }
   return "a quantity";
 }
@@ -123,6 +130,7 @@ std::string_view example(Dimension d) {
   case Dimension::force: return "0.1 N";
   case Dimension::force_per_length: return "300 N/m";
   case Dimension::viscosity: return "1 Pa s";
+  case Dimension::stiffness_per_area: return "1.9e9 N/m^3";
   }
   return "";
 }

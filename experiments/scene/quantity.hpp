@@ -22,6 +22,7 @@ enum class Dimension {
   force,           ///< N
   force_per_length,///< N/m (stiffness, force per unit contact length)
   viscosity,       ///< Pa s (= N s/m^2)
+  stiffness_per_area, ///< N/m^3 = Pa/m (an elastic foundation's stiffness per unit area)
 };
 
 /// Human name of a dimension with an example, for error messages: "a length (e.g. \"15 mm\")".

@@ -95,6 +95,11 @@ struct Tool {
   /// of the geometry (its mesh conforms to the rim), the same for the reference and every model
   /// that grasps, whatever the mesh. Absent: the stylus presses (contact), it does not grasp.
   std::optional<double> grasp_radius;
+  /// Sphere with a grasp_radius only: the disc is held by a compliant adhesive layer, an elastic
+  /// foundation of this stiffness per unit area k [N/m^3] > 0 between the disc and the tool
+  /// (traction on the body t = k (d − u), d the tool's displacement since contact; docs/scenes.md
+  /// "Grasp"). Absent: the disc moves rigidly with the tool (tied).
+  std::optional<double> grasp_stiffness;
   TrajectorySpec trajectory;
 };
 

@@ -627,11 +627,16 @@ private:
         check(b.thickness > 0.0, t, "thickness", "a length > 0");
       } else if (kind == "sphere") {
         tool.kind = Tool::Kind::sphere;
-        allow_only(t, {"name", "kind", "radius", "grasp_radius", "trajectory"}, "a sphere tool");
+        allow_only(t, {"name", "kind", "radius", "grasp_radius", "grasp_stiffness", "trajectory"}, "a sphere tool");
         tool.radius = required_quantity(t, "radius", Dimension::length);
         check(tool.radius > 0.0, t, "radius", "a length > 0");
         if ((tool.grasp_radius = optional_quantity(t, "grasp_radius", Dimension::length)))
           check(*tool.grasp_radius > 0.0, t, "grasp_radius", "a length > 0");
+        if ((tool.grasp_stiffness = optional_quantity(t, "grasp_stiffness", Dimension::stiffness_per_area))) {
+          check(*tool.grasp_stiffness > 0.0, t, "grasp_stiffness", "a stiffness per area > 0");
+          check(tool.grasp_radius.has_value(), t, "grasp_stiffness",
+                "a grasp_radius beside it (the stiffness is the grasped disc's)");
+        }
       } else {
         wrong(*t.find("kind"), t, t.key("kind"), "\"blade\" or \"sphere\"");
       }

@@ -3,8 +3,9 @@
 // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV (𝔸 = ∂P/∂F), the inertia M a(u) of the
 // Newmark step and the Kelvin–Voigt viscous stress (newmark_dynamics.cpp), the dead-load
 // tractions and the tool's frictionless penalty contact on the boundary faces; then the blade
-// edge pass (blade_edge_pass.cpp) and the cohesive interface (cohesive_interface.cpp). The
-// residual is R = f_int − f_ext (f_ext including the contact forces).
+// edge pass (blade_edge_pass.cpp), the elastic foundations (grasp_foundation.cpp) and the cohesive
+// interface (cohesive_interface.cpp). The residual is R = f_int − f_ext (f_ext including the
+// contact and foundation forces).
 
 #include "reference/solver/finite_strain_impl.hpp"
 
@@ -51,6 +52,7 @@ void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::Vec
   out.edge_length = 0.0;
   out.max_line_load = 0.0;
   if (blade_edge) assemble_blade_edge(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_ext);
+  assemble_foundations(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_ext);
   if (with_matrix) {
     la.K.compress(dealii::VectorOperation::add);
     rhs->compress(dealii::VectorOperation::add);
@@ -72,6 +74,8 @@ void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::Vec
   out.edge_points = static_cast<int>(tally[8]);
   out.edge_length = tally[9];
   out.contact_energy = tally[10];
+  for (Eigen::Vector3d& f : out.foundation_on_body) sum(std::span<double>(f.data(), 3));
+  out.foundation_energy = sum(out.foundation_energy);
   out.max_pressure = max(out.max_pressure);
   out.max_line_load = max(out.max_line_load);
   out.residual = f_int;

@@ -12,6 +12,7 @@
 //   newmark_dynamics.cpp    the dynamic step: consistent mass, Newmark update, Kelvin–Voigt forces
 //   blade_edge_pass.cpp     the wedge tool's edge in contact (contact/blade_edge_contact.hpp)
 //   cohesive_interface.cpp  the cohesive crack path: face pairs, opening, assembly, history commit
+//   grasp_foundation.cpp    elastic foundations (a compliant grasp): traction k (d − u), its tangent
 //   checkpoint_state.cpp    state() and set_state(): the solver's state as a vector of numbers
 //   field_output.cpp        write_fields: displacement, stresses and contact pressure as .vtu
 //   ../finite_strain_solver.cpp  the public class and the load-step driver (predictor, Newton)
@@ -42,6 +43,7 @@
 #include <array>
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -118,6 +120,14 @@ struct FiniteStrainSolver::Impl {
     if (b.kind != DisplacementBoundary::Kind::prescribed) return 0.0;
     return b.displacement(d.X, load)[d.component];
   }
+
+  // ---- Elastic foundations (grasp_foundation.cpp) -------------------------------------------------
+  struct Foundation {
+    int group = -1;         // surface group
+    double stiffness = 0.0; // k [N/m^3]
+    std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double load)> displacement;
+  };
+  std::vector<Foundation> foundations;
 
   // ---- The linear algebra (algebra.hpp) and the linear solver (tangent_solver.hpp) ---------------
   SerialAlgebra serial;
@@ -240,6 +250,8 @@ struct FiniteStrainSolver::Impl {
     double edge_length = 0.0;   // their share of the edge [m]
     double max_line_load = 0.0; // [N/m]
     double contact_energy = 0.0; // penalty energy stored in the tool contact (flanks and edge) [J]
+    std::vector<Eigen::Vector3d> foundation_on_body; // per foundation: ∫ k (d − u) dA [N]
+    double foundation_energy = 0.0;                  // ½ k ∫ |u − d|² dA over the foundations [J]
   };
 
   // ---- system_setup.cpp ---------------------------------------------------------------------------
@@ -294,6 +306,15 @@ struct FiniteStrainSolver::Impl {
   void assemble_blade_edge(const VectorType& state, const LoadState& load, bool with_matrix, Tally& out,
                            const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
                            VectorType& f_ext) const;
+
+  // ---- grasp_foundation.cpp -----------------------------------------------------------------------
+  void build_foundations(const FiniteStrainProblem& problem);
+  /// The foundations' traction k (d − u) on this process's faces into f_ext (and rhs), k ∫ N_a N_b dA
+  /// into K, their force on the body and energy into `out` (this process's share).
+  template <class VectorType, class MatrixType, class Tally>
+  void assemble_foundations(const VectorType& state, const LoadState& load, bool with_matrix, Tally& out,
+                            const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
+                            VectorType& f_ext) const;
 
   // ---- cohesive_interface.cpp ---------------------------------------------------------------------
   void build_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group);

@@ -272,6 +272,12 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
   report.tool_force = -assembly.contact_on_body;
   report.traction_resultant = assembly.traction_on_body;
   report.force_imbalance = report.traction_resultant - report.tool_force - report.support_reaction;
+  // The foundations: body on anchor = −∫ k (d − u) dA.
+  for (const Eigen::Vector3d& f : assembly.foundation_on_body) {
+    report.foundation_forces.push_back(-f);
+    report.force_imbalance += f;
+  }
+  report.foundation_energy = assembly.foundation_energy;
   report.edge_contact_points = assembly.edge_points;
   report.edge_contact_length = assembly.edge_length;
   report.max_edge_line_load = assembly.max_line_load;

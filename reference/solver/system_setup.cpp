@@ -237,6 +237,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     if (!(area > 0.0)) throw std::invalid_argument("finite strain solver: traction surface '" + t.surface + "' has no area");
     tractions.emplace_back(group, t.total_force / area);
   }
+  build_foundations(problem);
 
   // `tria` is the whole (refined) mesh on every process, so every process finds the same h_min.
   h_min = std::numeric_limits<double>::infinity();

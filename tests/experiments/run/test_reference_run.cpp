@@ -76,6 +76,42 @@ TEST(ReferenceRun, ClayPullStylusIsTiedAndItsForceBalancesTheSupport) {
   EXPECT_EQ(read_profile_csv(dir / "profile.csv").rows.size(), 4u);
 }
 
+// A compliant grasp (Tool::grasp_stiffness k): the stylus holds the disc through an elastic layer,
+// and its force is the layer's, −∫ k (d − u) dA. It is the tie's in the limit k → ∞ (a penalty
+// converges to its constraint at order 1/k: at k = 10⁴ E/h the layer's stretch is ~10⁻⁴ of the
+// body's, so the forces agree to well within 1 %); a softer layer gives a smaller force; and the
+// support alone balances the stylus (Newton's third law over the body: the layer is not a support).
+TEST(ReferenceRun, ClayPullCompliantGraspTendsToTheTieAndBalancesTheSupport) {
+  ClayPull tied, stiff, soft;
+  const double E = tied.scene.material.youngs_modulus, h = 0.01; // the box's 10 mm cells
+  stiff.scene.tools.front().grasp_stiffness = 1e4 * E / h;
+  soft.scene.tools.front().grasp_stiffness = 1.9e9; // docs/scenes.md "Grasp": a 1 mm layer of the clay
+  const ReferenceProblem rp = reference_problem(stiff.scene, stiff.mesh);
+  EXPECT_EQ(rp.tools.front().coupling.kind, ReferenceToolCoupling::Kind::tied);
+  EXPECT_EQ(rp.tools.front().coupling.foundation, 0);
+  EXPECT_EQ(rp.problem.foundations.size(), 1u);
+  ReferenceRunSettings s;
+  s.sample_indices = reference_sample_indices(tied.samples, 3);
+  s.write_fields = false;
+  const ForceProfile f_tied = run_reference(tied.scene, tied.mesh, s, scratch("tie_rigid"));
+  const fs::path dir = scratch("tie_stiff");
+  const ForceProfile f_stiff = run_reference(stiff.scene, stiff.mesh, s, dir);
+  const ForceProfile f_soft = run_reference(soft.scene, soft.mesh, s, scratch("tie_soft"));
+  ASSERT_EQ(f_stiff.rows.size(), 3u);
+  const nlohmann::json m = read_json(dir / "manifest.json");
+  EXPECT_EQ(m.at("solver").at("tools")[0].at("grasp_stiffness_N_per_m3").get<double>(), 1e4 * E / h);
+  for (std::size_t k = 1; k < f_stiff.rows.size(); ++k) {
+    SCOPED_TRACE(k);
+    const Eigen::Vector3d& F = f_stiff.rows[k].force;
+    EXPECT_LT(F.z(), 0.0); // the body holds the stylus back as it pulls up
+    EXPECT_LT((F - f_tied.rows[k].force).norm(), 1e-2 * f_tied.rows[k].force.norm());
+    EXPECT_LT(f_soft.rows[k].force.norm(), F.norm());
+    const auto& support_json = m.at("samples").at(k).at("support_reaction_N");
+    const Eigen::Vector3d support(support_json[0].get<double>(), support_json[1].get<double>(), support_json[2].get<double>());
+    EXPECT_LT((F + support).norm(), 1e-6 * F.norm());
+  }
+}
+
 // clay_tear (paper 000 §2.2): two styluses grasp the top at x = 15 and 45 mm and pull it apart,
 // 10 mm each along ∓x; the block slides on its table. Both styluses are tied, each with its own
 // tie, and the reference reports both forces. Checks: global equilibrium (the two stylus forces

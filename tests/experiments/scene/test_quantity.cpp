@@ -77,6 +77,12 @@ const Case cases[] = {
   {"1 Pa*s", Dimension::viscosity, 1.0},
   {"1 Pa.s", Dimension::viscosity, 1.0},
   {"0.5 N s/m^2", Dimension::viscosity, 0.5},   // paper 002 Table 1's unit
+  // stiffness per area (N/m^3 = Pa/m): 1 N/mm^3 = 1 N / 1e-9 m^3, 1 MPa/mm = 1e6 Pa / 1e-3 m
+  {"1.9e9 N/m^3", Dimension::stiffness_per_area, 1.9e9},
+  {"1.9 N/mm^3", Dimension::stiffness_per_area, 1.9e9},
+  {"5 Pa/m", Dimension::stiffness_per_area, 5.0},
+  {"2 kPa/mm", Dimension::stiffness_per_area, 2e6},
+  {"1.9 MPa/mm", Dimension::stiffness_per_area, 1.9e9},
   {"0.5 N*s/m^2", Dimension::viscosity, 0.5},
   {"3 mPa*s", Dimension::viscosity, 3e-3},
   {"3 mPa s", Dimension::viscosity, 3e-3},

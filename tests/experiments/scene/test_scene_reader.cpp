@@ -429,6 +429,40 @@ TEST_F(SceneReaderTest, ASphereCutsOnlyWithTheVoxelModel) {
   EXPECT_DOUBLE_EQ(s.voxel->critical_force_cutting, 0.1);
 }
 
+// A grasping stylus's compliant grasp: grasp_stiffness [N/m^3] read with its units (1.9 N/mm^3 =
+// 1.9 / 1e-9 N/m^3 = 1.9e9 N/m^3 by the unit's definition); a value of the wrong dimension, a
+// non-positive value or one without a grasp_radius refused at tools[0].grasp_stiffness.
+TEST_F(SceneReaderTest, GraspStiffnessIsReadWithUnits) {
+  auto grasping = [&](const std::string& extra) {
+    std::string text = minimal("geo = \"rect_prism.geo\"\nelement_size = 0.002\n",
+                               "kind = \"sphere\"\nradius = \"1 mm\"\n" + extra);
+    const std::string from = "phenomena = [\"deformation\", \"cutting\"]";
+    text.replace(text.find(from), from.size(), "phenomena = [\"deformation\"]");
+    return write("s.toml", text);
+  };
+  const Scene tied = read_scene(grasping("grasp_radius = \"4 mm\"\n"));
+  EXPECT_FALSE(tied.tools[0].grasp_stiffness.has_value()); // absent: the rigid tie
+  const Scene s = read_scene(grasping("grasp_radius = \"4 mm\"\ngrasp_stiffness = \"1.9 N/mm^3\"\n"));
+  ASSERT_TRUE(s.tools[0].grasp_stiffness.has_value());
+  expect_si(*s.tools[0].grasp_stiffness, 1.9e9);
+  expect_si(*read_scene(grasping("grasp_radius = \"4 mm\"\ngrasp_stiffness = \"1.9e9 N/m^3\"\n")).tools[0].grasp_stiffness,
+            1.9e9);
+  for (const std::string bad : {"grasp_radius = \"4 mm\"\ngrasp_stiffness = \"3 MPa\"\n",
+                                "grasp_radius = \"4 mm\"\ngrasp_stiffness = \"0 N/m^3\"\n",
+                                "grasp_stiffness = \"1.9e9 N/m^3\"\n"}) {
+    SCOPED_TRACE(bad);
+    const fs::path p = grasping(bad);
+    try {
+      (void)read_scene(p);
+      ADD_FAILURE() << "no SceneError";
+    } catch (const SceneError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind(p.string() + ":", 0), 0u) << m;
+      EXPECT_NE(m.find(": tools[0].grasp_stiffness: "), std::string::npos) << m;
+    }
+  }
+}
+
 TEST_F(SceneReaderTest, ErrorsNameTheFileAsGiven) {
   const fs::path p = write("s.toml", minimal() + "[models]\nfracturre = 1\n");
   try {
