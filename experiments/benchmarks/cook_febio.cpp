@@ -166,6 +166,8 @@ struct SolveOptions {
   bool full_newton = false;
   int steps = 10;
   double relative_tolerance = SolverSettings{}.relative_tolerance;
+  bool verbose = false; ///< each load step's |R| history on stderr
+  LineSearch line_search = SolverSettings{}.line_search;
 };
 
 int solve(const std::filesystem::path& msh, const SolveOptions& o) {
@@ -178,6 +180,7 @@ int solve(const std::filesystem::path& msh, const SolveOptions& o) {
   settings.quasi_newton = !o.full_newton;
   settings.extrapolate_initial_guess = !o.full_newton;
   settings.relative_tolerance = o.relative_tolerance;
+  settings.line_search = o.line_search;
   FiniteStrainSolver solver(p, settings);
   const double setup = cpu_seconds() - cpu0;
   int its = 0, factorizations = 0;
@@ -185,6 +188,11 @@ int solve(const std::filesystem::path& msh, const SolveOptions& o) {
   for (int step = 1; step <= o.steps; ++step) {
     const EquilibriumReport r = solver.solve({static_cast<double>(step) / o.steps, Eigen::Vector3d::Zero()});
     if (!r.converged) throw std::runtime_error("cook_febio: load step " + std::to_string(step) + " failed: " + r.failure);
+    if (o.verbose) {
+      std::fprintf(stderr, "step %d: %d iterations, %d factorisations, |R| [N]:", step, r.newton_iterations, r.factorizations);
+      for (const double x : r.residual_history) std::fprintf(stderr, " %.2e", x);
+      std::fprintf(stderr, "\n");
+    }
     its += r.newton_iterations;
     factorizations += r.factorizations;
     assembly += r.assembly_seconds;
@@ -221,6 +229,8 @@ int main(int argc, char** argv) try {
       if (arg == "--full-newton") o.full_newton = true;
       else if (arg == "--steps" && a + 1 < argc) o.steps = std::stoi(argv[++a]);
       else if (arg == "--tolerance" && a + 1 < argc) o.relative_tolerance = std::stod(argv[++a]);
+      else if (arg == "--verbose") o.verbose = true;
+      else if (arg == "--energy-line-search") o.line_search = LineSearch::energy;
       else throw std::invalid_argument("solve: unknown option " + arg);
     }
     if (o.steps < 1 || !(o.relative_tolerance > 0.0)) throw std::invalid_argument("solve: --steps >= 1 and --tolerance > 0");
