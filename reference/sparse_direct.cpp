@@ -20,13 +20,13 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 /// CHOLMOD 3 (SuiteSparse 5) opens the OpenMP loops of its supernodal factorisation with
 /// num_threads(CHOLMOD_OMP_NUM_THREADS), 4 compiled in, whatever OMP_NUM_THREADS says. Those loops
 /// clear, copy and scatter-add entry by entry (the arithmetic is BLAS's), so their threads mostly
-/// spin and wait: on two shared cores they cost ~15 % of the CPU time of Cook's membrane at 2 mm
+/// spin and wait: on two shared cores they cost 15–20 % of the CPU time of Cook's membrane at 2 mm
 /// (docs/reference.md, "Where the time goes"). While an object of this class lives, OpenMP's
 /// max-active-levels is 0, so that every parallel region runs on the thread that meets it (the
 /// OpenMP specification's rule for a team's size: one thread once the active levels reach
-/// max-active-levels). Each entry is computed by the same operations in the same order either
-/// way, so the factor is the same bit for bit. The OpenMP runtime is looked up, not linked:
-/// without one (a CHOLMOD built without OpenMP) there is nothing to do.
+/// max-active-levels). The loops write disjoint entries, each computed the same way on any
+/// thread, so the factor does not depend on the thread count. The OpenMP runtime is looked up,
+/// not linked: without one (a CHOLMOD built without OpenMP) there is nothing to do.
 class SerialOpenMP {
 public:
   SerialOpenMP() {

@@ -5,11 +5,15 @@
 //                           DIR/cook_hH.msh (kerf's input) and DIR/cook_hH.feb (FEBio's: the same
 //                           mesh as quadratic tetrahedra, tet10 with straight edges, which is what
 //                           kerf's P2 space builds on the .msh)
-//   cook_febio solve MSH [--full-newton]
+//   cook_febio solve MSH [--full-newton] [--steps N] [--tolerance REL] [--energy-line-search] [--verbose]
 //                           kerf's P2 reference on that mesh: the code gallery's energy, dead load,
-//                           10 load steps; prints the tip displacement and the phase times.
+//                           N equal load steps (default 10); prints the tip displacement and the
+//                           phase times.
 //                           --full-newton: a tangent factorised at every iteration and no predictor
 //                           (SolverSettings::quasi_newton and extrapolate_initial_guess off)
+//                           --tolerance: SolverSettings::relative_tolerance (default 1e-9)
+//                           --energy-line-search: LineSearch::energy (FEBio's line search)
+//                           --verbose: each step's |R| history on stderr
 //
 // The problem (docs/reference.md, "Cook's membrane"): clamped at x = 0, u_z = 0 on both faces
 // (plane strain), a dead-load shear of 1 N in total along +y on x = 48 mm; the code gallery's
@@ -236,7 +240,8 @@ int main(int argc, char** argv) try {
     if (o.steps < 1 || !(o.relative_tolerance > 0.0)) throw std::invalid_argument("solve: --steps >= 1 and --tolerance > 0");
     return solve(argv[2], o);
   }
-  std::cerr << "usage: cook_febio mesh H_MM DIR | cook_febio solve FILE.msh [--full-newton]\n";
+  std::cerr << "usage: cook_febio mesh H_MM DIR | cook_febio solve FILE.msh [--full-newton] [--steps N] "
+               "[--tolerance REL] [--energy-line-search] [--verbose]\n";
   return 2;
 } catch (const std::exception& e) {
   std::cerr << "cook_febio: " << e.what() << "\n";
