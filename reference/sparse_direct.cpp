@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <numeric>
 #include <stdexcept>
 
@@ -29,14 +30,21 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 /// not linked: without one (a CHOLMOD built without OpenMP) there is nothing to do.
 class SerialOpenMP {
 public:
+  // Reference solves may run on several threads at once (a study's tasks): the first one in saves
+  // the level and the last one out restores it. Every one sets 0, for a runtime that keeps the
+  // level per thread.
   SerialOpenMP() {
-    if (runtime().set != nullptr && runtime().get != nullptr) {
-      m_saved = runtime().get();
-      runtime().set(0);
-    }
+    const Runtime& r = runtime();
+    if (r.get == nullptr || r.set == nullptr) return;
+    const std::lock_guard lock(shared().mutex);
+    if (shared().users++ == 0) shared().saved = r.get();
+    r.set(0);
+    m_active = true;
   }
   ~SerialOpenMP() {
-    if (m_saved >= 0) runtime().set(m_saved);
+    if (!m_active) return;
+    const std::lock_guard lock(shared().mutex);
+    if (--shared().users == 0) runtime().set(shared().saved);
   }
   SerialOpenMP(const SerialOpenMP&) = delete;
   SerialOpenMP& operator=(const SerialOpenMP&) = delete;
@@ -46,12 +54,21 @@ private:
     int (*get)() = nullptr;
     void (*set)(int) = nullptr;
   };
+  struct Shared {
+    std::mutex mutex;
+    int users = 0;
+    int saved = 0;
+  };
   static const Runtime& runtime() {
     static const Runtime r{reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels")),
                            reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"))};
     return r;
   }
-  int m_saved = -1;
+  static Shared& shared() {
+    static Shared s;
+    return s;
+  }
+  bool m_active = false;
 };
 
 } // namespace
