@@ -122,6 +122,19 @@ enum class LinearSolverChoice {
   iterative  ///< PETSc CG + GAMG with the rigid-body near null space; unpreconditioned-norm stop
 };
 
+/// Newton's line search along the step du from u (newton_raphson.cpp).
+enum class LineSearch {
+  /// Backtracking α = 1, ½, … (6 tries) until the free residual's norm decreases,
+  /// |R(u + α du)| <= (1 − 10⁻⁴ α) |R(u)|.
+  residual_norm,
+  /// The energy's directional derivative s(α) = du · R(u + α du) (Matthies & Strang 1979, the line
+  /// search of their BFGS; FEBio's): α is accepted when |s(α)| <= 0.9 |s(0)|, else the next α is
+  /// the secant root α s(0) / (s(0) − s(α)), kept within [α/10, α/2] (6 tries). For a load with a
+  /// potential (hyperelasticity, dead loads) the full Newton step is taken far from equilibrium
+  /// where the residual's norm would cut it, though |R| may grow on that step.
+  energy
+};
+
 /// The load of one equilibrium solve.
 struct LoadState {
   double load_factor = 0.0;                               ///< scales tractions and prescribed u
@@ -138,6 +151,7 @@ struct SolverSettings {
   double relative_tolerance = 1e-9;     ///< Newton: |R_free| <= rel × (|f_int| + |f_ext|) + abs
   double absolute_tolerance = 1e-12;    ///< [N]
   int max_newton_iterations = 25;
+  LineSearch line_search = LineSearch::residual_norm;
   double iterative_tolerance = 1e-10;   ///< CG: true (unpreconditioned) residual relative to |b|
   /// Contact penalty ε_N [Pa/m]; 0 = automatic, 50 E_max / h_min (h_min the shortest edge after
   /// refinement), i.e. a penetration of 2% of an element under a stress of E.

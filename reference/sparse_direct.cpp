@@ -1,11 +1,13 @@
 #include "reference/sparse_direct.hpp"
 
 #include <cholmod.h>
+#include <dlfcn.h>
 #include <umfpack.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 #include <numeric>
 #include <stdexcept>
 
@@ -15,6 +17,59 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// CHOLMOD 3 (SuiteSparse 5) opens the OpenMP loops of its supernodal factorisation with
+/// num_threads(CHOLMOD_OMP_NUM_THREADS), 4 compiled in, whatever OMP_NUM_THREADS says. Those loops
+/// clear, copy and scatter-add entry by entry (the arithmetic is BLAS's), so their threads mostly
+/// spin and wait: on two shared cores they cost 15–20 % of the CPU time of Cook's membrane at 2 mm
+/// (docs/reference.md, "Where the time goes"). While an object of this class lives, OpenMP's
+/// max-active-levels is 0, so that every parallel region runs on the thread that meets it (the
+/// OpenMP specification's rule for a team's size: one thread once the active levels reach
+/// max-active-levels). The loops write disjoint entries, each computed the same way on any
+/// thread, so the factor does not depend on the thread count. The OpenMP runtime is looked up,
+/// not linked: without one (a CHOLMOD built without OpenMP) there is nothing to do.
+class SerialOpenMP {
+public:
+  // Reference solves may run on several threads at once (a study's tasks): the first one in saves
+  // the level and the last one out restores it. Every one sets 0, for a runtime that keeps the
+  // level per thread.
+  SerialOpenMP() {
+    const Runtime& r = runtime();
+    if (r.get == nullptr || r.set == nullptr) return;
+    const std::lock_guard lock(shared().mutex);
+    if (shared().users++ == 0) shared().saved = r.get();
+    r.set(0);
+    m_active = true;
+  }
+  ~SerialOpenMP() {
+    if (!m_active) return;
+    const std::lock_guard lock(shared().mutex);
+    if (--shared().users == 0) runtime().set(shared().saved);
+  }
+  SerialOpenMP(const SerialOpenMP&) = delete;
+  SerialOpenMP& operator=(const SerialOpenMP&) = delete;
+
+private:
+  struct Runtime {
+    int (*get)() = nullptr;
+    void (*set)(int) = nullptr;
+  };
+  struct Shared {
+    std::mutex mutex;
+    int users = 0;
+    int saved = 0;
+  };
+  static const Runtime& runtime() {
+    static const Runtime r{reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels")),
+                           reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"))};
+    return r;
+  }
+  static Shared& shared() {
+    static Shared s;
+    return s;
+  }
+  bool m_active = false;
+};
 
 } // namespace
 
@@ -129,6 +184,7 @@ bool SparseDirect::factorize_cholesky(const std::vector<double>& values) {
     if (c.A == nullptr) throw std::runtime_error("SparseDirect: CHOLMOD could not allocate the matrix");
     std::copy(col_start.begin(), col_start.end(), static_cast<SuiteSparse_long*>(c.A->p));
     std::copy(row_index.begin(), row_index.end(), static_cast<SuiteSparse_long*>(c.A->i));
+    const SerialOpenMP serial;
     c.L = cholmod_l_analyze(c.A, &c.common);
     if (c.L == nullptr || c.common.status < CHOLMOD_OK)
       throw std::runtime_error("SparseDirect: CHOLMOD's analysis failed (status " + std::to_string(c.common.status) + ")");
@@ -138,7 +194,10 @@ bool SparseDirect::factorize_cholesky(const std::vector<double>& values) {
   const auto t0 = Clock::now();
   auto* x = static_cast<double*>(c.A->x);
   for (std::size_t k = 0; k < c.source.size(); ++k) x[k] = values[static_cast<std::size_t>(c.source[k])];
-  cholmod_l_factorize(c.A, c.L, &c.common);
+  {
+    const SerialOpenMP serial;
+    cholmod_l_factorize(c.A, c.L, &c.common);
+  }
   m_counters.factorization_seconds += seconds_since(t0);
   if (c.common.status == CHOLMOD_NOT_POSDEF || c.L->minor < m_n) {
     ++m_counters.not_positive_definite;
@@ -200,7 +259,11 @@ void SparseDirect::solve(const double* b, double* x) const {
     B.x = const_cast<double*>(b);
     B.xtype = CHOLMOD_REAL;
     B.dtype = CHOLMOD_DOUBLE;
-    cholmod_dense* X = cholmod_l_solve(CHOLMOD_A, c.L, &B, &c.common);
+    cholmod_dense* X = nullptr;
+    {
+      const SerialOpenMP serial;
+      X = cholmod_l_solve(CHOLMOD_A, c.L, &B, &c.common);
+    }
     if (X == nullptr) throw std::runtime_error("SparseDirect: CHOLMOD's solve failed");
     std::copy_n(static_cast<const double*>(X->x), m_n, x);
     cholmod_l_free_dense(&X, &c.common);

@@ -5,11 +5,15 @@
 //                           DIR/cook_hH.msh (kerf's input) and DIR/cook_hH.feb (FEBio's: the same
 //                           mesh as quadratic tetrahedra, tet10 with straight edges, which is what
 //                           kerf's P2 space builds on the .msh)
-//   cook_febio solve MSH [--full-newton]
+//   cook_febio solve MSH [--full-newton] [--steps N] [--tolerance REL] [--energy-line-search] [--verbose]
 //                           kerf's P2 reference on that mesh: the code gallery's energy, dead load,
-//                           10 load steps; prints the tip displacement and the phase times.
+//                           N equal load steps (default 10); prints the tip displacement and the
+//                           phase times.
 //                           --full-newton: a tangent factorised at every iteration and no predictor
 //                           (SolverSettings::quasi_newton and extrapolate_initial_guess off)
+//                           --tolerance: SolverSettings::relative_tolerance (default 1e-9)
+//                           --energy-line-search: LineSearch::energy (FEBio's line search)
+//                           --verbose: each step's |R| history on stderr
 //
 // The problem (docs/reference.md, "Cook's membrane"): clamped at x = 0, u_z = 0 on both faces
 // (plane strain), a dead-load shear of 1 N in total along +y on x = 48 mm; the code gallery's
@@ -162,29 +166,44 @@ void write_feb(const TetMesh& mesh, const std::filesystem::path& file) {
   if (!out) throw std::runtime_error("cook_febio: writing " + file.string() + " failed");
 }
 
-int solve(const std::filesystem::path& msh, bool full_newton) {
+struct SolveOptions {
+  bool full_newton = false;
+  int steps = 10;
+  double relative_tolerance = SolverSettings{}.relative_tolerance;
+  bool verbose = false; ///< each load step's |R| history on stderr
+  LineSearch line_search = SolverSettings{}.line_search;
+};
+
+int solve(const std::filesystem::path& msh, const SolveOptions& o) {
   const double cpu0 = cpu_seconds();
   const auto wall0 = std::chrono::steady_clock::now();
   const FiniteStrainProblem p = test::cook_membrane_problem(read_msh(msh));
   SolverSettings settings;
   settings.degree = 2;
   settings.linear_solver = LinearSolverChoice::direct; // FEBio's skyline is direct too, at every size
-  settings.quasi_newton = !full_newton;
-  settings.extrapolate_initial_guess = !full_newton;
+  settings.quasi_newton = !o.full_newton;
+  settings.extrapolate_initial_guess = !o.full_newton;
+  settings.relative_tolerance = o.relative_tolerance;
+  settings.line_search = o.line_search;
   FiniteStrainSolver solver(p, settings);
   const double setup = cpu_seconds() - cpu0;
   int its = 0, factorizations = 0;
   double assembly = 0.0, linear = 0.0;
-  for (int step = 1; step <= 10; ++step) {
-    const EquilibriumReport r = solver.solve({step / 10.0, Eigen::Vector3d::Zero()});
+  for (int step = 1; step <= o.steps; ++step) {
+    const EquilibriumReport r = solver.solve({static_cast<double>(step) / o.steps, Eigen::Vector3d::Zero()});
     if (!r.converged) throw std::runtime_error("cook_febio: load step " + std::to_string(step) + " failed: " + r.failure);
+    if (o.verbose) {
+      std::fprintf(stderr, "step %d: %d iterations, %d factorisations, |R| [N]:", step, r.newton_iterations, r.factorizations);
+      for (const double x : r.residual_history) std::fprintf(stderr, " %.2e", x);
+      std::fprintf(stderr, "\n");
+    }
     its += r.newton_iterations;
     factorizations += r.factorizations;
     assembly += r.assembly_seconds;
     linear += r.linear_solve_seconds;
   }
   const double tip = solver.displacement_at(k_tip).y();
-  std::printf("kerf mesh=%s dofs=%zu tip_mm=%.6f newton=%d factorizations=%d setup_s=%.3f assembly_s=%.3f linear_s=%.3f cpu_s=%.3f wall_s=%.3f\n",
+  std::printf("kerf mesh=%s dofs=%zu tip_mm=%.9f newton=%d factorizations=%d setup_s=%.3f assembly_s=%.3f linear_s=%.3f cpu_s=%.3f wall_s=%.3f\n",
               msh.filename().string().c_str(), solver.dof_count(), tip * 1e3, its, factorizations, setup, assembly, linear,
               cpu_seconds() - cpu0, std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
   return 0;
@@ -207,9 +226,22 @@ int main(int argc, char** argv) try {
                 static_cast<long>(mesh.tets.rows()));
     return 0;
   }
-  if (mode == "solve" && (argc == 3 || (argc == 4 && std::string(argv[3]) == "--full-newton")))
-    return solve(argv[2], argc == 4);
-  std::cerr << "usage: cook_febio mesh H_MM DIR | cook_febio solve FILE.msh [--full-newton]\n";
+  if (mode == "solve" && argc >= 3) {
+    SolveOptions o;
+    for (int a = 3; a < argc; ++a) {
+      const std::string arg = argv[a];
+      if (arg == "--full-newton") o.full_newton = true;
+      else if (arg == "--steps" && a + 1 < argc) o.steps = std::stoi(argv[++a]);
+      else if (arg == "--tolerance" && a + 1 < argc) o.relative_tolerance = std::stod(argv[++a]);
+      else if (arg == "--verbose") o.verbose = true;
+      else if (arg == "--energy-line-search") o.line_search = LineSearch::energy;
+      else throw std::invalid_argument("solve: unknown option " + arg);
+    }
+    if (o.steps < 1 || !(o.relative_tolerance > 0.0)) throw std::invalid_argument("solve: --steps >= 1 and --tolerance > 0");
+    return solve(argv[2], o);
+  }
+  std::cerr << "usage: cook_febio mesh H_MM DIR | cook_febio solve FILE.msh [--full-newton] [--steps N] "
+               "[--tolerance REL] [--energy-line-search] [--verbose]\n";
   return 2;
 } catch (const std::exception& e) {
   std::cerr << "cook_febio: " << e.what() << "\n";

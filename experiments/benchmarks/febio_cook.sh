@@ -21,19 +21,27 @@
 #   export FEBIO=/tmp/febio-build/bin/febio4
 # Without MKL FEBio solves with its skyline solver (hence optimize_bw 1 in the inputs).
 #
-# Usage: experiments/benchmarks/febio_cook.sh [--mesh] [--repeat N] [H ...]
+# Usage: experiments/benchmarks/febio_cook.sh [--mesh] [--repeat N] [--steps N] [--kerf "ARGS"] [H ...]
 #   from the repository root, after `cmake --build build --target cook_febio`.
+#   --steps N   both codes take N equal load steps (default 10, the .feb's; FEBio's copy of the
+#               .feb is given time_steps N and step_size 1/N)
+#   --kerf ARGS more options of `cook_febio solve` (default "--energy-line-search": FEBio's line
+#               search, s(α) = du·R(u + α du), |s(α)| <= 0.9 |s(0)|)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 KERF=${KERF_COOK:-build/experiments/benchmarks/cook_febio}
 DIR=experiments/benchmarks/cook
 REPEAT=3
 MESH=0
+STEPS=10
+KERF_ARGS="--energy-line-search"
 SIZES=()
 while [[ $# -gt 0 ]]; do
   case $1 in
     --mesh) MESH=1 ;;
     --repeat) REPEAT=$2; shift ;;
+    --steps) STEPS=$2; shift ;;
+    --kerf) KERF_ARGS=$2; shift ;;
     *) SIZES+=("$1") ;;
   esac
   shift
@@ -56,22 +64,25 @@ RESULTS=$SCRATCH/results
 : > "$RESULTS"
 for h in "${SIZES[@]}"; do
   for ((k = 0; k < REPEAT; ++k)); do
-    t=$(timed "$KERF" solve "$DIR/cook_h$h.msh")
+    # shellcheck disable=SC2086 # KERF_ARGS is a list of options
+    t=$(timed "$KERF" solve "$DIR/cook_h$h.msh" --steps "$STEPS" $KERF_ARGS)
     tip=$(sed -n 's/.*tip_mm=\([0-9.e+-]*\).*/\1/p' "$SCRATCH/out")
     dofs=$(sed -n 's/.*dofs=\([0-9]*\).*/\1/p' "$SCRATCH/out")
     echo "kerf $h $t $tip $dofs" >> "$RESULTS"
     if [[ -n ${FEBIO:-} ]]; then
-      cp "$DIR/cook_h$h.feb" "$SCRATCH/cook.feb"
+      sed -e "s#<time_steps>10</time_steps>#<time_steps>$STEPS</time_steps>#" \
+          -e "s#<step_size>0.1</step_size>#<step_size>$(python3 -c "print(1 / $STEPS)")</step_size>#" \
+          "$DIR/cook_h$h.feb" > "$SCRATCH/cook.feb"
       t=$( (cd "$SCRATCH" && timed "$FEBIO" -i cook.feb -silent) )
       # The log file's last data record ("Data = uy", then "<node>,<u_y>"): the last converged step.
       tip=$(awk '/Data = uy/ { getline; last = $0 } END { n = split(last, f, /[ ,]+/); print f[n] + 0 }' "$SCRATCH/cook.log")
-      eqs=$(sed -n 's/.*Number of equations[ .]*: *\([0-9]*\).*/\1/p' "$SCRATCH/cook.log" | head -1)
+      eqs=$(sed -n 's/.*N[umbe]*r of equations[ .]*: *\([0-9]*\).*/\1/p' "$SCRATCH/cook.log" | head -1)
       echo "febio $h $t $tip ${eqs:-?}" >> "$RESULTS"
     fi
   done
 done
 
-python3 - "$RESULTS" <<'EOF'
+python3 - "$RESULTS" "$STEPS" "$KERF_ARGS" <<'EOF'
 import math, statistics, sys
 runs = {}
 for line in open(sys.argv[1]):
@@ -90,7 +101,7 @@ if len(kerf) >= 3:
     ref = c + (c - b) / (2 ** p - 1)
 else:
     ref = kerf[-1][2] if kerf else float("nan")
-print(f"Cook's membrane, P2 / tet10, 10 load steps, converged tip {ref:.5f} mm (Richardson, kerf's finest three)")
+print(f"Cook's membrane, P2 / tet10, {sys.argv[2]} load steps, kerf solve {sys.argv[3]!r}, converged tip {ref:.5f} mm (Richardson, kerf's finest three)")
 print(f"{'H mm':>5} {'code':>6} {'DOFs/eqs':>9} {'tip mm':>10} {'error mm':>9} {'cpu s':>8}")
 for h in sizes:
     for code in ("kerf", "febio"):

@@ -8,7 +8,9 @@
 
 #include "reference/material/finite_strain_error.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <type_traits>
 
@@ -141,11 +143,23 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
       // every element valid and reduces |R|, else the valid α with the smallest |R|. While a
       // Dirichlet increment is pending the residual is no merit function (it starts at zero and
       // must grow with the imposed displacement): then the largest valid α is taken.
+      // With LineSearch::energy, the test is on s(α) = du · R_free(u + α du) instead, the next α
+      // the secant root of s within [α/10, α/2].
       const VectorType base = la.u;
       double best_alpha = 0.0, best_r = std::numeric_limits<double>::infinity();
       bool full_valid = false, full_tangent = false;
       double full_mismatch = 0.0;
-      for (double alpha = 1.0; alpha > 1.0 / 64.0; alpha *= 0.5) {
+      const bool energy_search = m.settings.line_search == LineSearch::energy;
+      auto directional = [&](const VectorType& residual) {
+        VectorType masked = residual;
+        masked.scale(la.free_mask);
+        return du * masked;
+      };
+      const double s0 = energy_search ? directional(assembly.residual) : 0.0;
+      double next_alpha = 1.0;
+      for (int search = 0; search < 6; ++search) {
+        const double alpha = next_alpha;
+        next_alpha = 0.5 * alpha;
         la.u = base;
         la.u.add(alpha, du);
         Impl::Assembly<VectorType>& a = alpha == 1.0 ? full : trial;
@@ -183,6 +197,16 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
         if (rt < best_r) {
           best_r = rt;
           best_alpha = alpha;
+        }
+        if (energy_search && mismatch <= 0.0 && rt > tol) {
+          const double sa = directional(a.residual);
+          if (std::abs(sa) <= 0.9 * std::abs(s0)) {
+            best_alpha = alpha;
+            best_r = rt; // the accepted state's |R|, larger than an earlier trial's possibly
+            break;
+          }
+          if (s0 != sa) next_alpha = std::clamp(alpha * s0 / (s0 - sa), 0.1 * alpha, 0.5 * alpha);
+          continue;
         }
         if (mismatch > 0.0 || rt <= (1.0 - 1e-4 * alpha) * r || rt <= tol) {
           best_alpha = alpha;

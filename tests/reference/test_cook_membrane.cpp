@@ -39,5 +39,24 @@ TEST(CookMembrane, P2TetrahedraConvergeToThePlaneStrainValue) {
   EXPECT_NEAR(tip, febio, 0.01 * febio) << "tip " << tip * 1e3 << " mm";
 }
 
+TEST(CookMembrane, EnergyLineSearchReachesTheSameEquilibriumInOneLoadStep) {
+  // A second method for the same equilibrium: the dead load has a potential, so the equilibrium
+  // at full load does not depend on the load path. Ten steps with the default line search (|R|
+  // backtracking) against one step of the whole load with LineSearch::energy (Matthies & Strang
+  // 1979); both stop at |R| <= 1e-9 of the force scale, so their tips agree far below 1e-6.
+  const FiniteStrainProblem p = test::cook_membrane_problem(test::cook_membrane(4), true);
+  const Eigen::Vector3d tip(48e-3, 52e-3, 0.5e-3);
+  SolverSettings settings;
+  settings.degree = 2;
+  FiniteStrainSolver stepped(p, settings);
+  for (int step = 1; step <= 10; ++step) ASSERT_TRUE(stepped.solve({step / 10.0, Eigen::Vector3d::Zero()}).converged);
+  settings.line_search = LineSearch::energy;
+  FiniteStrainSolver direct(p, settings);
+  const EquilibriumReport r = direct.solve({1.0, Eigen::Vector3d::Zero()});
+  ASSERT_TRUE(r.converged) << r.failure;
+  EXPECT_NEAR(r.support_reaction.y(), 1.0, 1e-6);
+  EXPECT_NEAR(direct.displacement_at(tip).y(), stepped.displacement_at(tip).y(), 1e-6 * stepped.displacement_at(tip).y());
+}
+
 } // namespace
 } // namespace kerf::reference
