@@ -61,8 +61,11 @@ for t in "${targets[@]}"; do
     rc=0; wait $pid || rc=$?
     runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
     cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1 | grep -oE '[0-9]+' || echo "?")
-    # libFuzzer exits 0 or 72 (interrupted) without a finding; a finding leaves a crash-/leak-/timeout- file.
-    if ls "$crashes"/* > /dev/null 2>&1 || { [ $rc -ne 0 ] && [ $rc -ne 72 ] && [ $rc -ne 130 ]; }; then
+    # libFuzzer exits 0 or 72 (interrupted) without a finding; a finding leaves a crash-, leak-,
+    # timeout- or oom- file (a slow-unit- file is an input slower than 10 s, under the 60 s hang
+    # limit: the large valid trajectories, not a finding).
+    if ls "$crashes"/crash-* "$crashes"/leak-* "$crashes"/timeout-* "$crashes"/oom-* > /dev/null 2>&1 ||
+       { [ $rc -ne 0 ] && [ $rc -ne 72 ] && [ $rc -ne 130 ]; }; then
       result=finding; status=1
       echo "fuzz_$t: FINDING after $used CPU s (log $log, input in $crashes/):"
       grep -E 'ERROR|runtime error|SUMMARY|what\(\)|Test unit written' "$log" | head -8 || true
