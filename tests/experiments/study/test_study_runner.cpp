@@ -618,10 +618,29 @@ TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
     EXPECT_NE(f.speed, 1.0); // the scene's own trajectory stays held out
   }
   EXPECT_EQ(fits, (std::set<std::pair<std::string, std::string>>{{"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}}));
-  // Solution verification: three mesh levels for every scene (Reference III), the potato's own
-  // (a scene of its own levels, [reference] scene_refinements), clay_pull's the study's.
+  // Solution verification: three mesh levels for every scene (Reference III), the finest the
+  // scene's own mesh, the potato's levels its own ([reference] scene_refinements).
   EXPECT_EQ(s.reference.levels_of("clay_pull"), (std::vector<int>{-2, -1, 0}));
-  EXPECT_EQ(s.reference.levels_of("potato_rect_cut"), (std::vector<int>{-3, -2, -1}));
+  EXPECT_EQ(s.reference.levels_of("potato_rect_cut"), (std::vector<int>{-2, -1, 0}));
+  // The shipped references, beside the study files.
+  EXPECT_EQ(s.reference.library, (fs::path(KERF_STUDIES_DIR) / ".." / "references").lexically_normal());
+}
+
+TEST(StudySpec, TheReferenceLibraryIsAFolderBesideTheStudy) {
+  const StudySpec s = read_study(write_study("lib.toml", "[study]\nname = \"t\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n"
+                                                         "[reference]\nlibrary = \"kept/refs\"\n"));
+  EXPECT_EQ(s.reference.library.filename(), "refs");
+  EXPECT_EQ(s.reference.library.parent_path().filename(), "kept");
+  for (const char* bad : {"library = \"\"", "library = 3"}) {
+    SCOPED_TRACE(bad);
+    try {
+      (void)read_study(write_study("bad.toml", std::string("[study]\nname = \"t\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n[reference]\n") +
+                                                   bad + "\n"));
+      ADD_FAILURE() << "no StudyError";
+    } catch (const StudyError& e) {
+      EXPECT_NE(std::string(e.what()).find("reference.library"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(StudySpec, ReadsModelResolutions) {
