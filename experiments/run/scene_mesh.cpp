@@ -74,8 +74,7 @@ std::map<std::string, double> scene_mesh_parameters(const Scene& scene, MeshPurp
     const double rim = std::min(nominal, a / grasp_rim_elements_per_radius) * scale;
     finest_rim = finest_rim > 0.0 ? std::min(finest_rim, rim) : rim;
   }
-  if (purpose == MeshPurpose::reference && finest_rim > 0.0) p["grasp_element_size"] = finest_rim;
-  if (purpose == MeshPurpose::reference && finest_rim > 0.0 && g.grasp_element_size) p["grasp_element_size"] = *g.grasp_element_size;
+  if (purpose == MeshPurpose::reference && finest_rim > 0.0) p["grasp_element_size"] = g.grasp_element_size.value_or(finest_rim);
   if (purpose == MeshPurpose::reference) add_crack_path_grading(scene, nominal, scale, p);
   return p;
 }

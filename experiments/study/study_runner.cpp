@@ -360,18 +360,21 @@ StudyPlan plan_study(const StudySpec& spec, const std::filesystem::path& out, bo
   return plan;
 }
 
-/// Copies a solve's library entry (reference_library.hpp) into the study's cache when the library
+/// Copies a reference solve's files from one entry folder (cache or library) to another, each
+/// written atomically, the profile last: its presence marks the entry as complete.
+void copy_reference_entry(const std::filesystem::path& from, const std::filesystem::path& to) {
+  for (const char* f : {"manifest.json", "key.txt", "profile.csv"})
+    if (std::filesystem::exists(from / f)) write_text(to / f, read_text(from / f));
+}
+
+/// Copies a solve's library entry into the study's cache when the library
 /// holds one under the solve's key: the same key text, so the same scene, mesh, samples and solver.
 void take_from_library(const std::filesystem::path& library, const ReferenceSolve& solve) {
   namespace fs = std::filesystem;
   if (library.empty()) return;
   const fs::path entry = library / solve.dir.filename();
   if (!fs::exists(entry / "profile.csv") || !fs::exists(entry / "key.txt") || read_text(entry / "key.txt") != solve.key_text) return;
-  fs::create_directories(solve.dir);
-  for (const char* f : {"manifest.json", "key.txt"})
-    if (fs::exists(entry / f)) fs::copy_file(entry / f, solve.dir / f, fs::copy_options::overwrite_existing);
-  // The profile last: its presence marks the cache entry as complete.
-  write_text(solve.dir / "profile.csv", read_text(entry / "profile.csv"));
+  copy_reference_entry(entry, solve.dir);
 }
 
 } // namespace
@@ -686,9 +689,7 @@ int publish_references(const std::vector<StudyReferenceSolve>& solves, const std
   for (const StudyReferenceSolve& solve : solves) {
     if (!fs::exists(solve.dir / "profile.csv")) continue;
     const fs::path entry = library / solve.dir.filename();
-    fs::create_directories(entry);
-    for (const char* f : {"manifest.json", "key.txt", "profile.csv"})
-      if (fs::exists(solve.dir / f)) write_text(entry / f, read_text(solve.dir / f));
+    copy_reference_entry(solve.dir, entry);
     write_text(entry / "command.txt", command + "\n");
     ++published;
   }

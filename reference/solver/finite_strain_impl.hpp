@@ -309,6 +309,8 @@ struct FiniteStrainSolver::Impl {
 
   // ---- grasp_foundation.cpp -----------------------------------------------------------------------
   void build_foundations(const FiniteStrainProblem& problem);
+  /// The reference area of surface group `group` [m²], summed over the processes (system_setup.cpp).
+  double surface_area(int group) const;
   /// The foundations' traction k (d − u) on this process's faces into f_ext (and rhs), k ∫ N_a N_b dA
   /// into K, their force on the body and energy into `out` (this process's share).
   template <class VectorType, class MatrixType, class Tally>

@@ -29,15 +29,7 @@ void FiniteStrainSolver::Impl::build_foundations(const FiniteStrainProblem& prob
     if (!e.displacement)
       throw std::invalid_argument("finite strain solver: elastic foundation '" + e.surface + "' has no displacement");
     const int group = static_cast<int>(it - surface_names.begin());
-    double area = 0.0;
-    dealii::FEFaceValues<3> fv(*mapping, *fe, *face_quadrature, dealii::update_JxW_values);
-    for (const auto& cell : dof.active_cell_iterators())
-      for (const unsigned f : cell->face_indices())
-        if (cell->is_locally_owned() && cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), group)) {
-          fv.reinit(cell, f);
-          for (unsigned q = 0; q < fv.n_quadrature_points; ++q) area += fv.JxW(q);
-        }
-    if (!(sum(area) > 0.0))
+    if (!(surface_area(group) > 0.0))
       throw std::invalid_argument("finite strain solver: elastic foundation surface '" + e.surface + "' has no area");
     foundations.push_back({group, e.stiffness, e.displacement});
   }

@@ -225,15 +225,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
 
   for (const TractionBoundary& t : problem.tractions) {
     const int group = group_of(t.surface, "traction");
-    double area = 0.0;
-    dealii::FEFaceValues<3> fv(*mapping, *fe, *face_quadrature, dealii::update_JxW_values);
-    for (const auto& cell : dof.active_cell_iterators())
-      for (const unsigned f : cell->face_indices())
-        if (cell->is_locally_owned() && cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), group)) {
-          fv.reinit(cell, f);
-          for (unsigned q = 0; q < fv.n_quadrature_points; ++q) area += fv.JxW(q);
-        }
-    area = sum(area);
+    const double area = surface_area(group);
     if (!(area > 0.0)) throw std::invalid_argument("finite strain solver: traction surface '" + t.surface + "' has no area");
     tractions.emplace_back(group, t.total_force / area);
   }
@@ -327,6 +319,18 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   std::vector<dealii::Point<3>> owned_support;
   for (const auto i : la.owned) owned_support.push_back(support[i]);
   linear = std::make_unique<TangentSolver>(kind, std::move(owned_support), settings.iterative_tolerance, true, spd);
+}
+
+double FiniteStrainSolver::Impl::surface_area(int group) const {
+  double area = 0.0;
+  dealii::FEFaceValues<3> fv(*mapping, *fe, *face_quadrature, dealii::update_JxW_values);
+  for (const auto& cell : dof.active_cell_iterators())
+    for (const unsigned f : cell->face_indices())
+      if (cell->is_locally_owned() && cell->face(f)->at_boundary() && in_group(cell->face(f)->boundary_id(), group)) {
+        fv.reinit(cell, f);
+        for (unsigned q = 0; q < fv.n_quadrature_points; ++q) area += fv.JxW(q);
+      }
+  return sum(area);
 }
 
 void FiniteStrainSolver::Impl::build_cell_geometry() {
