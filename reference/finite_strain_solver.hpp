@@ -80,6 +80,10 @@ struct ElasticFoundation {
   double stiffness = 0.0; ///< k [N/m^3] > 0: traction per unit reference area per metre of stretch
   /// The anchor's displacement [m] at reference point X [m] and load factor in [0, 1].
   std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double load)> displacement;
+  /// The layer's stiffness at reference point X as a fraction of `stiffness`, in [0, 1]; absent:
+  /// uniform (1). A profile that falls to zero at the surface's rim keeps the traction continuous
+  /// there (a uniform layer ends in a traction step at the rim, which concentrates the stress).
+  std::function<double(const Eigen::Vector3d& X)> profile;
 };
 
 /// A dead-load traction: a uniform traction per unit reference area on a named surface whose
