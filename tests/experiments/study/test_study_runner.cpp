@@ -36,12 +36,15 @@ fs::path write_study(const std::string& name, const std::string& text) {
 TEST(StudySpec, ReadsScenesModelsAndReference) {
   const StudySpec s = read_study(write_study("ok.toml", "[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\n"
                                                         "models = [\"fracture\"]\n[reference]\ndegree = 2\n"
-                                                        "refinements = [0, 1, 2]\nsamples = 12\n"));
+                                                        "refinements = [0, 1, 2]\nsamples = 12\n"
+                                                        "scene_degree = { potato_rect_cut = 1 }\n"));
   EXPECT_EQ(s.name, "t");
   ASSERT_EQ(s.scenes.size(), 1u);
   EXPECT_EQ(s.scenes[0].filename(), "potato_rect_cut.toml");
   EXPECT_TRUE(s.has_reference);
   EXPECT_EQ(s.reference.degree, 2);
+  EXPECT_EQ(s.reference.degree_of("potato_rect_cut"), 1); // its own degree
+  EXPECT_EQ(s.reference.degree_of("clay_pull"), 2);       // the study's
   EXPECT_EQ(s.reference.refinements, (std::vector<int>{0, 1, 2}));
   EXPECT_EQ(s.reference.samples, 12);
 }
@@ -63,6 +66,12 @@ TEST(StudySpec, ErrorsNameFileLineColumnAndKey) {
       {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
        "scene_refinements = { potato_rect_cut = [0, -1] }\n",
        ":6:45: reference.scene_refinements.potato_rect_cut"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
+       "scene_degree = { potato_rect_cut = 3 }\n",
+       ":6:36: reference.scene_degree.potato_rect_cut"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
+       "scene_degree = { clay_pull = 2 }\n",
+       ":6:30: reference.scene_degree.clay_pull"},
   };
   int k = 0;
   for (const auto& [text, expected] : cases) {
