@@ -560,6 +560,16 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
             verified.note = "fails its resolution check: " + manifest.at("fracture").at("warning").get<std::string>() + "; " +
                             verified.note;
         }
+      // A level whose load path stopped short of the trajectory's end (its manifest's `stopped`) is
+      // verified and scored on the samples it reached only: its row says so first.
+      for (std::size_t k : scenes[s].levels)
+        if (fs::exists(solves[k].dir / "manifest.json")) {
+          std::ifstream in(solves[k].dir / "manifest.json");
+          const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
+          if (!manifest.is_discarded() && manifest.contains("stopped") && manifest.at("stopped").is_string())
+            verified.note = "L" + std::to_string(solves[k].level) + " stopped before the trajectory's end (" +
+                            manifest.at("stopped").get<std::string>().substr(0, 160) + "…); " + verified.note;
+        }
       char size[64];
       std::snprintf(size, sizeof size, "mesh h = %.3g mm; ", study_reference_element_size(scene, finest_level) * 1e3);
       StudyRow row{scene.name, "reference L" + std::to_string(finest_level), std::nullopt, cost_statistics(*finest), size + verified.note, {}};

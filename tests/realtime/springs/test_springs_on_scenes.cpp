@@ -108,7 +108,7 @@ TEST(SpringsOnScenes, ClayPullWritesTheEmbeddedMeshSeries) {
     worst = std::max(worst, d);
   }
   EXPECT_LT(worst, 1e-12);
-  // The pull moved the fine mesh: by about the 8 mm pull at the stylus.
-  EXPECT_GT((written - rest).rowwise().norm().maxCoeff(), 5e-3);
+  // The pull moved the fine mesh: by about the 6 mm pull at the stylus.
+  EXPECT_GT((written - rest).rowwise().norm().maxCoeff(), 4e-3);
   EXPECT_GT(embedding.embedded_count(), 0);
 }
