@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -74,19 +75,31 @@ LumpedGraspLayer lump_grasp_layer(const SpringNetwork& net, const GraspLayer& la
                                 std::to_string(layer.normal.z()) + ")");
   const int side = layer.normal[axis] > 0.0 ? 1 : 0; // the cell face at the cell's upper (1) or lower (0) side
   const double h = net.block.cell_size;
-  const double plane = (layer.centre[axis] - net.block.origin[axis]) / h; // in cells
-  const double layer_index = std::round(plane);
-  if (std::abs(plane - layer_index) > 1e-6)
-    throw std::invalid_argument("springs: the compliant grasp's face (coordinate " + std::to_string(layer.centre[axis] * 1e3) +
-                                " mm along axis " + std::to_string(axis) +
-                                ") is not a plane of the network's lattice; the network must end on the grasped face");
   const int u_axis = (axis + 1) % 3, v_axis = (axis + 2) % 3;
+  // The network's face under the centre: the outermost outer face, along the normal, of the kept
+  // cells whose face squares hold the centre's projection. It is the body's face when the
+  // lattice ends on it, else the lattice plane within h/2 of it that the pruning kept.
+  const Eigen::Vector3d local = (layer.centre - net.block.origin) / h;
+  const double slack = 1e-9;
+  int layer_index = side ? std::numeric_limits<int>::min() : std::numeric_limits<int>::max();
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const Eigen::Vector3i& g = net.cell_index[static_cast<std::size_t>(c)];
+    if (local[u_axis] < g[u_axis] - slack || local[u_axis] > g[u_axis] + 1 + slack || local[v_axis] < g[v_axis] - slack ||
+        local[v_axis] > g[v_axis] + 1 + slack)
+      continue;
+    layer_index = side ? std::max(layer_index, g[axis] + 1) : std::min(layer_index, g[axis]);
+  }
+  if (layer_index == std::numeric_limits<int>::min() || layer_index == std::numeric_limits<int>::max() ||
+      std::abs(layer_index - local[axis]) > 0.5 + 1e-6)
+    throw std::invalid_argument("springs: the network has no face within half a cell (" + std::to_string(0.5 * h * 1e3) +
+                                " mm) of the compliant grasp's centre (" + std::to_string(layer.centre.x() * 1e3) + ", " +
+                                std::to_string(layer.centre.y() * 1e3) + ", " + std::to_string(layer.centre.z() * 1e3) + ") mm");
   const double a = layer.radius;
   const double finest = a / 1024.0;
   std::vector<double> K(static_cast<std::size_t>(net.node_count), 0.0);
   for (int c = 0; c < net.cell_count(); ++c) {
     const Eigen::Vector3i& g = net.cell_index[static_cast<std::size_t>(c)];
-    if (g[axis] + side != static_cast<int>(layer_index)) continue;
+    if (g[axis] + side != layer_index) continue;
     Eigen::Vector3i beyond = g;
     beyond[axis] += side ? 1 : -1;
     if (net.cell_at_index(beyond) >= 0) continue; // an inner face

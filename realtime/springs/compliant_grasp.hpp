@@ -26,9 +26,11 @@ struct LumpedGraspLayer {
   std::vector<double> stiffness;
 };
 
-/// The layer's stiffness per node of the network's face through the disc: the faces of kept cells
-/// that lie in the plane through `centre` normal to `normal`, on the network's boundary (no kept
-/// cell beyond them). On such a face square the network's displacement is bilinear in the
+/// The layer's stiffness per node of the network's face under the disc: the outer faces (no kept
+/// cell beyond them) of kept cells in the plane of the lattice normal to `normal` that bounds the
+/// network at the centre's projection — the body's face itself when the lattice ends on it,
+/// otherwise the network's face within h/2 of it (the disc is then taken on that face, centred
+/// at the centre's projection). On such a face square the network's displacement is bilinear in the
 /// corners' (the cell's trilinear shape functions restricted to the face), u = Σ_p N_p u_p, so
 /// the layer's energy ½ ∫ k(r) |d − u|² dA has the nodal stiffness matrix ∫ N_p N_q k(r) dA I,
 /// lumped by rows (Σ_q N_q = 1):
@@ -39,8 +41,8 @@ struct LumpedGraspLayer {
 /// Σ_p K_p X_p = ∫ k(r) X dA (bilinear interpolation reproduces linear fields), so the lumped
 /// layer has the continuous one's force and centre at any cell size. Returns the nodes with
 /// K_p > 0 in node order. Throws std::invalid_argument when the normal is not a coordinate axis,
-/// the plane is not a plane of the block's lattice, or the faces cover less than 99.9 % of ∫ k dA
-/// over the disc (the disc reaches past the network's face), naming the reason.
+/// no face of the network lies within h/2 of the centre, or the faces cover less than 99.9 % of
+/// ∫ k dA over the disc (the disc reaches past the network's face), naming the reason.
 LumpedGraspLayer lump_grasp_layer(const SpringNetwork& net, const GraspLayer& layer);
 
 } // namespace kerf

@@ -85,12 +85,17 @@ TEST(CompliantGrasp, CentreNodeStiffnessHasItsClosedForm) {
   }
 }
 
-TEST(CompliantGrasp, RefusesADiscBeyondTheFaceAndAFaceOffTheLattice) {
+TEST(CompliantGrasp, TakesTheNetworksFaceAndRefusesADiscBeyondIt) {
   const SpringNetwork net = test::full_block(4, 5e-3, CellStiffness{1.0, 1.0, 1.0, 0.0});
   // The disc reaches past the block's edge.
   EXPECT_THROW(lump_grasp_layer(net, GraspLayer{{0.001, 0.01, 0.02}, Eigen::Vector3d::UnitZ(), 4e-3, clay_k}), std::invalid_argument);
-  // A plane between lattice planes.
-  EXPECT_THROW(lump_grasp_layer(net, GraspLayer{{0.01, 0.01, 0.019}, Eigen::Vector3d::UnitZ(), 4e-3, clay_k}), std::invalid_argument);
+  // A centre more than half a cell from the network's face.
+  EXPECT_THROW(lump_grasp_layer(net, GraspLayer{{0.01, 0.01, 0.017}, Eigen::Vector3d::UnitZ(), 4e-3, clay_k}), std::invalid_argument);
+  // Within half a cell: the layer sits on the network's face (z = 20 mm), the same as a centre on it.
+  const LumpedGraspLayer below = lump_grasp_layer(net, GraspLayer{{0.01, 0.01, 0.018}, Eigen::Vector3d::UnitZ(), 4e-3, clay_k});
+  const LumpedGraspLayer on = lump_grasp_layer(net, GraspLayer{{0.01, 0.01, 0.02}, Eigen::Vector3d::UnitZ(), 4e-3, clay_k});
+  EXPECT_EQ(below.node, on.node);
+  EXPECT_EQ(below.stiffness, on.stiffness);
   // A normal off the axes.
   EXPECT_THROW(lump_grasp_layer(net, GraspLayer{{0.01, 0.01, 0.02}, Eigen::Vector3d(1, 0, 1).normalized(), 4e-3, clay_k}),
                std::invalid_argument);
