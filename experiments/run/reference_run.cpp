@@ -105,10 +105,8 @@ ReferenceToolCoupling tie_stylus(const Scene& scene, const TetMesh& mesh, const 
     // distance from the grasp centre, R the grasp radius, so the traction on the body falls
     // continuously to zero at the rim (a uniform layer's traction step there concentrates the stress
     // into a fold of the free surface beside the rim that no mesh resolves).
-    const Eigen::Vector3d centre = c.contact_point;
-    const double R = *tool.grasp_radius;
-    auto profile = [centre, R](const Eigen::Vector3d& X) { return std::max(0.0, 1.0 - (X - centre).squaredNorm() / (R * R)); };
-    p.foundations.push_back({tie_name, *tool.grasp_stiffness, tool_displacement, profile});
+    p.foundations.push_back({tie_name, *tool.grasp_stiffness, tool_displacement,
+                             reference::ElasticFoundation::tapered_disc(c.contact_point, *tool.grasp_radius)});
     return c;
   }
   c.boundary = static_cast<int>(p.displacement_boundaries.size());
