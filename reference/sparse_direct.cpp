@@ -162,7 +162,12 @@ void SparseDirect::factorize(const std::vector<double>& values) {
   m_last_cholesky = false;
 }
 
-bool SparseDirect::factorize_cholesky(const std::vector<double>& values) {
+double SparseDirect::cholesky_factor_entries() {
+  analyze_cholesky();
+  return m_cholmod->common.lnz;
+}
+
+void SparseDirect::analyze_cholesky() {
   if (!m_cholmod) {
     const auto t0 = Clock::now();
     m_cholmod = std::make_unique<Cholmod>();
@@ -190,6 +195,10 @@ bool SparseDirect::factorize_cholesky(const std::vector<double>& values) {
       throw std::runtime_error("SparseDirect: CHOLMOD's analysis failed (status " + std::to_string(c.common.status) + ")");
     m_counters.analysis_seconds += seconds_since(t0);
   }
+}
+
+bool SparseDirect::factorize_cholesky(const std::vector<double>& values) {
+  analyze_cholesky();
   Cholmod& c = *m_cholmod;
   const auto t0 = Clock::now();
   auto* x = static_cast<double*>(c.A->x);
