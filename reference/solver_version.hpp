@@ -13,6 +13,6 @@
 
 namespace kerf::reference {
 
-inline constexpr int solver_version = 1;
+inline constexpr int solver_version = 2;
 
 } // namespace kerf::reference

@@ -30,8 +30,9 @@ struct Recorded {
   double top_centre_uz;  ///< displacement of the top face's centre [m]
 };
 
-// Recorded at solver_version 1.
-constexpr int recorded_version = 1;
+// Recorded at solver_version 1; unchanged at 2 (version 2 changed the cohesive interface's Newton
+// tangent, and so the load path of cohesive problems, which this contact problem does not have).
+constexpr int recorded_version = 2;
 constexpr Recorded recorded[] = {
     {LawKind::neo_hookean, 0.2e-3, 0.016255006743663546, 3.6468403499959687e-08, -1.7448232701213008e-05},
     {LawKind::neo_hookean, 0.4e-3, 0.1835432044673154, 3.4721048657634074e-06, -0.00019462096659265718},
