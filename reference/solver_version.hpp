@@ -13,7 +13,9 @@
 
 namespace kerf::reference {
 
-// 2: a grasped disc's elastic layer tapers to zero at its rim (ElasticFoundation::tapered_disc).
-inline constexpr int solver_version = 2;
+// 2: the cohesive interface's Newton tangent (secant only while the iteration is unsettled)
+//    changes the load path of cohesive problems.
+// 3: a grasped disc's elastic layer tapers to zero at its rim (ElasticFoundation::tapered_disc).
+inline constexpr int solver_version = 3;
 
 } // namespace kerf::reference

@@ -91,20 +91,29 @@ std::string TangentSolver::name() const {
   return m_distributed ? "mumps" : "cholmod/umfpack";
 }
 
+void TangentSolver::make_direct(const dealii::SparsityPattern& pattern) {
+  if (m_direct) return;
+  // The pattern in deal.II's storage order (each row's diagonal first), once per problem.
+  std::vector<std::int64_t> row_start{0}, columns;
+  columns.reserve(pattern.n_nonzero_elements());
+  for (std::size_t r = 0; r < pattern.n_rows(); ++r) {
+    for (auto it = pattern.begin(r); it != pattern.end(r); ++it) columns.push_back(static_cast<std::int64_t>(it->column()));
+    row_start.push_back(static_cast<std::int64_t>(columns.size()));
+  }
+  m_values.resize(columns.size());
+  m_direct = std::make_unique<SparseDirect>(pattern.n_rows(), std::move(row_start), std::move(columns));
+}
+
+double TangentSolver::cholesky_factor_entries(const dealii::SparsityPattern& pattern) {
+  if (m_kind != Kind::direct || m_distributed)
+    throw std::logic_error("TangentSolver::cholesky_factor_entries: serial direct solver only");
+  make_direct(pattern);
+  return m_direct->cholesky_factor_entries();
+}
+
 void TangentSolver::factorize(const dealii::SparseMatrix<double>& K) {
   if (m_kind != Kind::direct || m_distributed) throw std::logic_error("TangentSolver::factorize: serial direct solver only");
-  const dealii::SparsityPattern& pattern = K.get_sparsity_pattern();
-  if (!m_direct) {
-    // The pattern in deal.II's storage order (each row's diagonal first), once per problem.
-    std::vector<std::int64_t> row_start{0}, columns;
-    columns.reserve(pattern.n_nonzero_elements());
-    for (std::size_t r = 0; r < K.m(); ++r) {
-      for (auto it = pattern.begin(r); it != pattern.end(r); ++it) columns.push_back(static_cast<std::int64_t>(it->column()));
-      row_start.push_back(static_cast<std::int64_t>(columns.size()));
-    }
-    m_values.resize(columns.size());
-    m_direct = std::make_unique<SparseDirect>(K.m(), std::move(row_start), std::move(columns));
-  }
+  make_direct(K.get_sparsity_pattern());
   std::size_t k = 0;
   for (std::size_t r = 0; r < K.m(); ++r)
     for (auto it = K.begin(r); it != K.end(r); ++it) m_values[k++] = it->value();

@@ -44,6 +44,10 @@ public:
   /// Solves K x = b. Returns the number of iterations (0 for the direct solver). Throws
   /// std::runtime_error if the factorisation or the iteration fails.
   int solve(const dealii::SparseMatrix<double>& K, dealii::Vector<double>& x, const dealii::Vector<double>& b);
+  /// Serial direct solver only: the entries of the Cholesky factor of a matrix with this pattern,
+  /// as CHOLMOD's analysis predicts them (SparseDirect::cholesky_factor_entries; the analysis is
+  /// kept for the factorisations of matrices of this pattern).
+  double cholesky_factor_entries(const dealii::SparsityPattern& pattern);
   /// Serial direct solver only: factorises K (kept for `solve_factorized`).
   void factorize(const dealii::SparseMatrix<double>& K);
   /// Serial direct solver: whether a factorisation is at hand (the last `factorize` succeeded).
@@ -73,6 +77,7 @@ private:
   bool m_factorized = false;
   bool m_distributed;
   bool m_spd;
+  void make_direct(const dealii::SparsityPattern& pattern);
 };
 
 } // namespace kerf::reference

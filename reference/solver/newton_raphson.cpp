@@ -70,9 +70,39 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
     return fault_answer;
   };
   // A cohesive interface whose points switch between loading and unloading can make the
-  // consistent Newton iteration cycle; after a third of the allowed iterations the secant
-  // interface tangent takes over (slower, but it does not cycle). It changes the tangent only.
-  auto secant = [&](int it) { return m.cohesive_law.has_value() && it >= m.settings.max_newton_iterations / 3; };
+  // consistent Newton iteration cycle. From a third of the allowed iterations on, a step that is
+  // not good (a shortened step, or |R| reduced by less than `good_ratio`) hands the interface to
+  // its secant tangent (slower, but it does not cycle); once `needed` secant steps in a row are
+  // good, the iteration has settled and the consistent tangent returns, so that the last
+  // iterations converge quadratically instead of linearly. Each return that ends in another
+  // switch doubles `needed`, so that a cycling iteration stays with the secant. The choice changes
+  // the tangent only, never the residual or the equilibrium.
+  struct InterfaceTangent {
+    bool secant = false;
+    int good_run = 0; // good secant steps in a row
+    int needed = 1;   // good secant steps before the consistent tangent returns
+    bool returned = false;
+  };
+  constexpr double good_ratio = 0.7;
+  InterfaceTangent interface_tangent;
+  // The tangent of iteration `next` after a step that was (not) good.
+  auto after_step = [&](InterfaceTangent t, int next, bool good) {
+    if (!m.cohesive_law || next < m.settings.max_newton_iterations / 3) return InterfaceTangent{};
+    if (!t.secant) {
+      if (!good) {
+        t.secant = true;
+        t.good_run = 0;
+        if (t.returned) t.needed *= 2;
+      }
+      return t;
+    }
+    t.good_run = good ? t.good_run + 1 : 0;
+    if (t.good_run >= t.needed) {
+      t.secant = false;
+      t.returned = true;
+    }
+    return t;
+  };
   auto fail = [&](std::string why) {
     la.u = start;
     report.converged = false;
@@ -84,7 +114,7 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
       auto t0 = Clock::now();
       if (!assembled) {
         mismatch = m.dirichlet_constraints(la, la.u, load, constraints);
-        m.cohesive_secant = secant(it);
+        m.cohesive_secant = interface_tangent.secant;
         m.poison_residual = fault(it);
         with_tangent = newton_next || mismatch > 0.0;
         m.assemble(la, la.u, load, with_tangent, assembly, with_tangent ? &constraints : nullptr,
@@ -108,7 +138,7 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
       if (newton_step && !with_tangent) {
         // The state's residual came from a line search: its tangent is assembled now.
         t0 = Clock::now();
-        m.cohesive_secant = secant(it);
+        m.cohesive_secant = interface_tangent.secant;
         m.assemble(la, la.u, load, true, assembly, &constraints, &rhs);
         report.assembly_seconds += seconds_since(t0);
       }
@@ -147,7 +177,7 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
       // the secant root of s within [α/10, α/2].
       const VectorType base = la.u;
       double best_alpha = 0.0, best_r = std::numeric_limits<double>::infinity();
-      bool full_valid = false, full_tangent = false;
+      bool full_valid = false, full_tangent = false, full_secant = false;
       double full_mismatch = 0.0;
       const bool energy_search = m.settings.line_search == LineSearch::energy;
       auto directional = [&](const VectorType& residual) {
@@ -168,7 +198,9 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
           // The full step, assembled as the next iteration would (its constraints, fault; the
           // tangent when this step is a Newton step, whose successor is likely one too).
           full_mismatch = m.dirichlet_constraints(la, la.u, load, full_constraints);
-          m.cohesive_secant = secant(it + 1);
+          // The tangent of the next iteration if this step is good (it is accepted whole).
+          full_secant = after_step(interface_tangent, it + 1, true).secant;
+          m.cohesive_secant = full_secant;
           const bool poisoned = fault(it + 1);
           m.poison_residual = poisoned;
           full_tangent = newton_step || !quasi_newton_allowed;
@@ -184,7 +216,7 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
           m.poison_residual = false;
           full_valid = true;
         } else {
-          m.cohesive_secant = secant(it);
+          m.cohesive_secant = interface_tangent.secant;
           try {
             m.assemble(la, la.u, load, false, trial, nullptr, nullptr);
           } catch (const FiniteStrainError&) {
@@ -248,8 +280,12 @@ EquilibriumReport FiniteStrainSolver::Impl::newton(Algebra& la, const LoadState&
           newton_next = !(best_r <= 0.5 * r) || S.size() >= max_updates;
         }
       }
+      interface_tangent = after_step(interface_tangent, it + 1, best_alpha == 1.0 && best_r <= good_ratio * r);
       if (best_alpha == 1.0 && full_valid) {
         std::swap(assembly, full);
+        // A step accepted whole that was not good: its tangent is assembled again with the
+        // interface tangent chosen now (at the loop's top).
+        if (full_tangent && full_secant != interface_tangent.secant) full_tangent = false;
         if (full_tangent) {
           rhs.swap(full_rhs);
           std::swap(constraints, full_constraints);

@@ -265,8 +265,14 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
                    group_of(problem.cohesive->minus_surface, "cohesive"));
   }
 
+  if (!(settings.direct_factor_limit >= 0.0) || !std::isfinite(settings.direct_factor_limit))
+    throw std::invalid_argument("finite strain solver: direct_factor_limit must be a finite number of entries >= 0, got " +
+                                std::to_string(settings.direct_factor_limit));
+  // Automatic: direct up to direct_dof_limit DOFs; above it, serially, direct while the
+  // predicted factor fits direct_factor_limit (below), distributed the iterative solver.
   const bool direct = settings.linear_solver == LinearSolverChoice::direct ||
-                      (settings.linear_solver == LinearSolverChoice::automatic && dof.n_dofs() <= settings.direct_dof_limit);
+                      (settings.linear_solver == LinearSolverChoice::automatic &&
+                       (dof.n_dofs() <= settings.direct_dof_limit || (!distributed && settings.direct_factor_limit > 0.0)));
   const auto kind = direct ? TangentSolver::Kind::direct : TangentSolver::Kind::iterative;
   // Contact and a softening cohesive interface make the tangent indefinite: GMRES instead of CG.
   const bool spd = !tool && !cohesive_law;
@@ -288,6 +294,18 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
     serial.free_mask.reinit(dof.n_dofs());
     serial.free_mask = 1.0;
     for (const auto& d : dirichlet) serial.free_mask[d.index] = 0.0;
+    // Automatic above direct_dof_limit: direct while CHOLMOD's analysis predicts a Cholesky
+    // factor of at most direct_factor_limit entries (memory), else the iterative solver.
+    if (direct && settings.linear_solver == LinearSolverChoice::automatic && dof.n_dofs() > settings.direct_dof_limit) {
+      auto candidate = std::make_unique<TangentSolver>(kind, support, settings.iterative_tolerance, false, spd);
+      if (candidate->cholesky_factor_entries(serial.pattern) <= settings.direct_factor_limit) {
+        linear = std::move(candidate);
+        return;
+      }
+      linear = std::make_unique<TangentSolver>(TangentSolver::Kind::iterative, std::move(support), settings.iterative_tolerance,
+                                               false, spd);
+      return;
+    }
     linear = std::make_unique<TangentSolver>(kind, std::move(support), settings.iterative_tolerance, false, spd);
     return;
   }
@@ -337,23 +355,38 @@ void FiniteStrainSolver::Impl::build_cell_geometry() {
   const dealii::FE_SimplexP<3> scalar(static_cast<unsigned>(settings.degree));
   CellGeometry& g = geometry;
   g.nodes = scalar.n_dofs_per_cell();
-  g.points = cell_quadrature->size();
+  const unsigned points = cell_quadrature->size();
+  // Linear tetrahedra on straight (affine) cells have constant shape gradients, so F, the stress
+  // and the tangent are the same at every quadrature point: the cell integrals are the integrand
+  // at one point times the cell's volume Σ_q JxW_q. One point is kept per cell then (checked:
+  // every point's gradients equal the first's to round-off, else all points are kept).
+  g.points = settings.degree == 1 ? 1 : points;
   const unsigned n = fe->n_dofs_per_cell();
   g.node_of_dof.resize(n);
   for (unsigned i = 0; i < n; ++i) g.node_of_dof[i] = fe->system_to_component_index(i).second;
   const std::size_t cells = dof.get_triangulation().n_active_cells();
-  g.gradients.assign(cells * g.points * g.nodes * 3, 0.0);
-  g.JxW.assign(cells * g.points, 0.0);
   dealii::FEValues<3> fv(*mapping, scalar, *cell_quadrature, dealii::update_gradients | dealii::update_JxW_values);
-  for (const auto& cell : dof.get_triangulation().active_cell_iterators()) {
-    if (!cell->is_locally_owned()) continue;
-    fv.reinit(cell);
-    const std::size_t c = cell->active_cell_index();
-    for (unsigned q = 0; q < g.points; ++q) {
-      g.JxW[c * g.points + q] = fv.JxW(q);
-      for (unsigned a = 0; a < g.nodes; ++a)
-        for (unsigned d = 0; d < 3; ++d) g.gradients[((c * g.points + q) * g.nodes + a) * 3 + d] = fv.shape_grad(a, q)[d];
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    g.gradients.assign(cells * g.points * g.nodes * 3, 0.0);
+    g.JxW.assign(cells * g.points, 0.0);
+    bool constant = true;
+    for (const auto& cell : dof.get_triangulation().active_cell_iterators()) {
+      if (!cell->is_locally_owned()) continue;
+      fv.reinit(cell);
+      const std::size_t c = cell->active_cell_index();
+      for (unsigned q = 0; q < points; ++q) {
+        const unsigned k = g.points == 1 ? 0 : q;
+        g.JxW[c * g.points + k] += fv.JxW(q);
+        for (unsigned a = 0; a < g.nodes; ++a) {
+          const dealii::Tensor<1, 3> grad = fv.shape_grad(a, q);
+          if (g.points == 1 && (grad - fv.shape_grad(a, 0)).norm() > 1e-12 * fv.shape_grad(a, 0).norm()) constant = false;
+          if (q == k)
+            for (unsigned d = 0; d < 3; ++d) g.gradients[((c * g.points + k) * g.nodes + a) * 3 + d] = grad[d];
+        }
+      }
     }
+    if (constant || g.points == points) return;
+    g.points = points; // curved or non-affine cells: every quadrature point
   }
 }
 

@@ -82,6 +82,28 @@ TEST(SparseDirect, CholeskyWhenSymmetricPositiveDefiniteLuOtherwise) {
   EXPECT_EQ(solver.counters().lu, 2);
 }
 
+// The predicted factor size against closed forms: a tridiagonal matrix's Cholesky factor has no
+// fill under an ordering that eliminates a path from its ends (minimum degree does), so L holds
+// the n diagonal and n − 1 subdiagonal entries; a dense matrix's L is its whole lower triangle,
+// n (n + 1)/2 entries. Values follow, and the analysis is kept: a factorisation then works.
+TEST(SparseDirect, PredictsTheCholeskyFactorsEntries) {
+  const Tridiagonal t(300);
+  SparseDirect tridiagonal(t.n, t.row_start, t.columns);
+  EXPECT_EQ(tridiagonal.cholesky_factor_entries(), 2.0 * 300 - 1);
+  const auto spd = t.values([](std::size_t) { return 2.0; }, [](std::size_t) { return -1.0; }, [](std::size_t) { return -1.0; });
+  EXPECT_LT(solve_error(tridiagonal, t, spd), 1e-9);
+  EXPECT_EQ(tridiagonal.counters().cholesky, 1);
+
+  const std::size_t n = 40;
+  std::vector<std::int64_t> row_start{0}, columns;
+  for (std::size_t r = 0; r < n; ++r) {
+    for (std::size_t c = 0; c < n; ++c) columns.push_back(static_cast<std::int64_t>(c));
+    row_start.push_back(static_cast<std::int64_t>(columns.size()));
+  }
+  SparseDirect dense(n, row_start, columns);
+  EXPECT_EQ(dense.cholesky_factor_entries(), static_cast<double>(n * (n + 1) / 2));
+}
+
 TEST(SparseDirect, RefusesValuesThatDoNotMatchThePattern) {
   const Tridiagonal t(5);
   SparseDirect solver(t.n, t.row_start, t.columns);
