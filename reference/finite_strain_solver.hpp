@@ -159,18 +159,11 @@ struct SolverSettings {
   int degree = 1;        ///< FE_SimplexP degree, 1 or 2
   int refinements = 0;   ///< global refinements of the mesh (each splits a tetrahedron into 8)
   LinearSolverChoice linear_solver = LinearSolverChoice::automatic;
-<<<<<<< HEAD
-  /// automatic: direct up to this many DOFs. CG + GAMG stalls on the indefinite or ill-conditioned
-  /// tangents of nearly incompressible finite strain (clay_pull, P2, 63 000 DOFs: indefinite
-  /// preconditioner at 4.6 mm of pull), where a sparse Cholesky or LU of this size takes seconds.
-  std::size_t direct_dof_limit = 200000;
-=======
   std::size_t direct_dof_limit = 60000; ///< automatic: direct up to this many DOFs
   /// automatic, serial, above direct_dof_limit: direct while CHOLMOD's analysis of the tangent's
   /// pattern predicts at most this many entries in the Cholesky factor (8 bytes each; UMFPACK's
   /// LU, which takes an indefinite tangent, needs several times that), else iterative; 0: never.
   double direct_factor_limit = 1e8;
->>>>>>> potato
   double relative_tolerance = 1e-9;     ///< Newton: |R_free| <= rel × (|f_int| + |f_ext|) + abs
   double absolute_tolerance = 1e-12;    ///< [N]
   int max_newton_iterations = 25;

@@ -120,6 +120,7 @@ ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSett
   text += "refinements = " + std::to_string(settings.refinements) + "\n";
   text += "linear_solver = " + std::string(solver_name(settings.linear_solver)) + "\n";
   text += "direct_dof_limit = " + std::to_string(defaults.direct_dof_limit) + "\n";
+  text += "direct_factor_limit = " + exact(defaults.direct_factor_limit) + "\n";
   text += "iterative_tolerance = " + exact(defaults.iterative_tolerance) + "\n";
   text += "newton_relative_tolerance = " + exact(defaults.relative_tolerance) + "\n";
   text += "newton_absolute_tolerance = " + exact(defaults.absolute_tolerance) + "\n";

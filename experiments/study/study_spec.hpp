@@ -84,7 +84,7 @@ struct StudyReferenceSpec {
   }
   int samples = 40; ///< equilibrium solves along each trajectory (evenly spaced samples)
   /// Linear solver of each Newton step (reference/finite_strain_solver.hpp): "auto" (direct below
-  /// 200 000 DOFs), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
+  /// 60 000 DOFs, and above while the Cholesky factor stays small), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
   reference::LinearSolverChoice linear_solver = reference::LinearSolverChoice::automatic;
   /// Cohesive fracture along the scene's cut_plane (experiments/run/reference_fracture.hpp): "off"
   /// (default, as `kerf reference`), "auto" or "on".
