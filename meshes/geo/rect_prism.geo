@@ -13,7 +13,7 @@
 // grasp_element_size > 0 grades the mesh to that size on each rim, growing linearly with the
 // distance d from it, s = grasp_element_size + grasp_size_growth d, up to the caller's element size
 // (a gmsh Distance field on the rims and a MathEval of it).
-// kerf sets these from the scene (experiments/scene/scene_mesh.cpp); a .geo user may set them by hand.
+// kerf sets these from the scene (experiments/run/scene_mesh.cpp); a .geo user may set them by hand.
 SetFactory("OpenCASCADE");
 
 DefineConstant[
