@@ -80,6 +80,18 @@ struct ElasticFoundation {
   double stiffness = 0.0; ///< k [N/m^3] > 0: traction per unit reference area per metre of stretch
   /// The anchor's displacement [m] at reference point X [m] and load factor in [0, 1].
   std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double load)> displacement;
+  /// The layer's stiffness at reference point X as a fraction of `stiffness`, in [0, 1]; absent:
+  /// uniform (1). A profile that falls to zero at the surface's rim keeps the traction continuous
+  /// there (a uniform layer ends in a traction step at the rim, which concentrates the stress).
+  std::function<double(const Eigen::Vector3d& X)> profile;
+
+  /// The profile of a grasped disc's layer: stiffest at the disc's centre c, ending at its rim,
+  /// k(X)/k = max(0, 1 − |X − c|²/a²) for a disc of radius a (docs/scenes.md, "Grasp").
+  static std::function<double(const Eigen::Vector3d& X)> tapered_disc(const Eigen::Vector3d& centre, double radius) {
+    return [centre, radius](const Eigen::Vector3d& X) {
+      return std::max(0.0, 1.0 - (X - centre).squaredNorm() / (radius * radius));
+    };
+  }
 };
 
 /// A dead-load traction: a uniform traction per unit reference area on a named surface whose
@@ -147,7 +159,10 @@ struct SolverSettings {
   int degree = 1;        ///< FE_SimplexP degree, 1 or 2
   int refinements = 0;   ///< global refinements of the mesh (each splits a tetrahedron into 8)
   LinearSolverChoice linear_solver = LinearSolverChoice::automatic;
-  std::size_t direct_dof_limit = 60000; ///< automatic: direct below this many DOFs
+  /// automatic: direct up to this many DOFs. CG + GAMG stalls on the indefinite or ill-conditioned
+  /// tangents of nearly incompressible finite strain (clay_pull, P2, 63 000 DOFs: indefinite
+  /// preconditioner at 4.6 mm of pull), where a sparse Cholesky or LU of this size takes seconds.
+  std::size_t direct_dof_limit = 200000;
   double relative_tolerance = 1e-9;     ///< Newton: |R_free| <= rel × (|f_int| + |f_ext|) + abs
   double absolute_tolerance = 1e-12;    ///< [N]
   int max_newton_iterations = 25;

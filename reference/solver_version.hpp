@@ -13,6 +13,7 @@
 
 namespace kerf::reference {
 
-inline constexpr int solver_version = 1;
+// 2: a grasped disc's elastic layer tapers to zero at its rim (ElasticFoundation::tapered_disc).
+inline constexpr int solver_version = 2;
 
 } // namespace kerf::reference

@@ -49,7 +49,7 @@ ForceProfile reference_profile(const Scene& scene, int refine, int samples, cons
   std::size_t n = 0;
   for (const auto& t : sample_scene_trajectories(scene)) n = std::max(n, t.samples.size());
   const std::vector<std::size_t> indices = reference_sample_indices(n, samples);
-  const ReferenceCacheKey key = reference_cache_key(scene, study_reference_settings(spec, refine, indices));
+  const ReferenceCacheKey key = reference_cache_key(scene, study_reference_settings(spec, scene, refine, indices));
   std::ostringstream cached;
   if (std::ifstream k(dir / "key.txt"); k) cached << k.rdbuf();
   if (cached.str() == key.text && fs::exists(dir / "profile.csv")) return read_profile_csv(dir / "profile.csv");

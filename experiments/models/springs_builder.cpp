@@ -11,6 +11,7 @@
 #include "realtime/springs/spring_network_model.hpp"
 #include "realtime/springs/torn_tet_mesh.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -210,7 +211,14 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
       // command line says otherwise (the explicit limit shrinks with the crushed springs).
       if (!settings.integrator && options.find("integrator") == options.end()) setup.integrator = SpringIntegrator::implicit_euler;
     } else {
-      setup.styluses.push_back({t.trajectory.start, t.radius});
+      // A compliant grasp (Tool::grasp_stiffness, the reference's elastic foundation): the same
+      // layer k(r) = k (1 − r²/a²) on the same disc, lumped onto the network's face nodes.
+      SpringStylus stylus{t.trajectory.start, t.radius};
+      if (t.grasp_stiffness && t.grasp_radius) {
+        stylus.grasp_stiffness = *t.grasp_stiffness;
+        stylus.grasp_disc_radius = *t.grasp_radius;
+      }
+      setup.styluses.push_back(stylus);
     }
   }
 
@@ -238,12 +246,19 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
   p["bulk_modulus_error"] = id.bulk_modulus_error;
   p["damping_time_s"] = net.damping_time;
   p["volume_term"] = id.stiffness.volume_modulus > 0.0;
-  p["grasp_radius_m"] = setup.grasp_radius > 0.0 ? nlohmann::json(setup.grasp_radius) : nlohmann::json("tip radius + h/2");
-  // The network attaches the grasped nodes rigidly; a scene's compliant grasp (Tool::grasp_stiffness,
-  // the reference's elastic foundation) is not represented: say so beside the results.
-  for (const Tool& t : scene.tools)
-    if (t.grasp_stiffness) {
-      p["grasp"] = "rigid: the scene's grasp_stiffness is not represented by the network";
+  // The rigid grasp's radius, where a stylus grasps rigidly.
+  if (std::any_of(setup.styluses.begin(), setup.styluses.end(), [](const SpringStylus& t) { return !(t.grasp_stiffness > 0.0); }))
+    p["grasp_radius_m"] = setup.grasp_radius > 0.0 ? nlohmann::json(setup.grasp_radius) : nlohmann::json("tip radius + h/2");
+  // A compliant grasp: the layer's parameters and its lumped anchors, per stylus.
+  for (std::size_t t = 0; t < setup.styluses.size(); ++t)
+    if (const SpringStylus& stylus = setup.styluses[t]; stylus.grasp_stiffness > 0.0) {
+      p["grasp"] = "compliant: k(r) = k (1 - r^2/a^2) on the disc of radius a around the contact point, lumped onto the network's "
+                   "face nodes as anchor springs K_p = integral of N_p k(r) dA (docs/spring-network.md §3)";
+      p["grasp_stiffness_N_per_m3"] = stylus.grasp_stiffness;
+      p["grasp_disc_radius_m"] = stylus.grasp_disc_radius;
+      p["grasp_anchors"] = nlohmann::json::array();
+      for (int k = 0; k < model->tool_count(); ++k)
+        p["grasp_anchors"].push_back({{"nodes", model->anchored_nodes(k)}, {"stiffness_sum_N_per_m", model->anchor_stiffness(k)}});
       break;
     }
   p["explicit_stability_limit_s"] = model->stability_limit();

@@ -102,7 +102,12 @@ ReferenceToolCoupling tie_stylus(const Scene& scene, const TetMesh& mesh, const 
     // A compliant grasp: the disc is held to the tool by an elastic layer, t = k (d − u).
     c.grasp_stiffness = *tool.grasp_stiffness;
     c.foundation = static_cast<int>(p.foundations.size());
-    p.foundations.push_back({tie_name, *tool.grasp_stiffness, tool_displacement});
+    // The layer is stiffest under the tip's centre and ends at the rim: k(r) = k (1 − r²/R²), r the
+    // distance from the grasp centre, R the grasp radius, so the traction on the body falls
+    // continuously to zero at the rim (a uniform layer's traction step there concentrates the stress
+    // into a fold of the free surface beside the rim that no mesh resolves).
+    p.foundations.push_back({tie_name, *tool.grasp_stiffness, tool_displacement,
+                             reference::ElasticFoundation::tapered_disc(c.contact_point, *tool.grasp_radius)});
     return c;
   }
   c.boundary = static_cast<int>(p.displacement_boundaries.size());

@@ -23,7 +23,7 @@ enum class MeshPurpose { scene, reference };
 /// min(h, a / grasp_rim_elements_per_radius), growing away from the rim by half the distance
 /// (grasp_size_growth 0.5). The tied disc's traction is singular at its rim (a rigid punch,
 /// Johnson 1985 §3.8: p ∝ (a² − r²)^(-1/2)), so the force converges only where the rim is resolved.
-inline constexpr double grasp_rim_elements_per_radius = 6.0;
+inline constexpr double grasp_rim_elements_per_radius = 12.0;
 
 /// The .geo parameters kerf derives from `scene` for `purpose`, beside the scene file's own:
 /// - `grasp<k>_radius`, `grasp<k>_x`, `grasp<k>_y` (k = 1, 2 in tool order) for each sphere tool

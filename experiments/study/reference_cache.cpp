@@ -15,10 +15,10 @@
 
 namespace kerf {
 
-ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, int level,
+ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, const Scene& scene, int level,
                                               const std::vector<std::size_t>& sample_indices) {
   ReferenceRunSettings settings;
-  settings.degree = spec.degree;
+  settings.degree = spec.degree_of(scene.file.stem().string());
   settings.refinements = std::max(level, 0);
   settings.sample_indices = sample_indices;
   settings.write_fields = false;

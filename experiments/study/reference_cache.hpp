@@ -22,12 +22,12 @@
 
 namespace kerf {
 
-/// The settings a study's reference solve at mesh level `level` runs with: `spec`'s degree,
-/// linear solver and fracture mode, the solved `sample_indices`, no field files, the mesh refined
+/// The settings a study's reference solve of `scene` at mesh level `level` runs with: `spec`'s
+/// degree for the scene (StudyReferenceSpec::degree_of its file's stem), linear solver and fracture mode, the solved `sample_indices`, no field files, the mesh refined
 /// max(level, 0) times (a level below 0 is a coarser mesh instead: study_reference_scene), and the
 /// mesh not distributed (each solve is one process's run, whatever the study's MPI ranks:
 /// study_runner.hpp).
-ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, int level,
+ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, const Scene& scene, int level,
                                               const std::vector<std::size_t>& sample_indices);
 
 /// The scene a study's reference solves at mesh level `level`: `scene` itself for a level >= 0

@@ -53,7 +53,7 @@ ForceProfile subsample(const ForceProfile& profile, const std::vector<std::size_
 ReferenceRunner finite_element_reference() {
   return [](const Scene& scene, const StudyReferenceSpec& spec, int level, const std::vector<std::size_t>& indices,
             const std::filesystem::path& dir) {
-    return run_reference(scene, scene_mesh(scene, MeshPurpose::reference), study_reference_settings(spec, level, indices), dir);
+    return run_reference(scene, scene_mesh(scene, MeshPurpose::reference), study_reference_settings(spec, scene, level, indices), dir);
   };
 }
 
@@ -293,7 +293,7 @@ StudyPlan plan_study(const StudySpec& spec, const std::filesystem::path& out, bo
   const bool with_reference = spec.has_reference && reference_wanted;
   const auto plan_solve = [&](const Scene& scene, int level, int samples) {
     ReferenceSolve solve{study_reference_scene(scene, level), level, solved_samples(scene, samples), {}, {}};
-    const ReferenceCacheKey key = reference_cache_key(solve.scene, study_reference_settings(spec.reference, level, solve.indices));
+    const ReferenceCacheKey key = reference_cache_key(solve.scene, study_reference_settings(spec.reference, solve.scene, level, solve.indices));
     solve.dir = out / "cache" / key.directory;
     solve.key_text = key.text;
     solves.push_back(std::move(solve));
@@ -542,7 +542,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     if (finest) {
       const int finest_level = references.rbegin()->first;
       try {
-        verified.verification = verify_reference(levels, tool, spec.reference.degree + 1.0);
+        verified.verification = verify_reference(levels, tool, spec.reference.degree_of(scene.file.stem().string()) + 1.0);
         verified.note = verified.verification ? verified.verification->summary()
                                               : "no GCI available: " + std::to_string(levels.size()) +
                                                     " mesh level(s), solution verification needs 3 ([reference] refinements)";
@@ -560,6 +560,16 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
               manifest.at("fracture").at("warning").is_string() && !manifest.at("fracture").at("warning").get<std::string>().empty())
             verified.note = "fails its resolution check: " + manifest.at("fracture").at("warning").get<std::string>() + "; " +
                             verified.note;
+        }
+      // A level whose load path stopped short of the trajectory's end (its manifest's `stopped`) is
+      // verified and scored on the samples it reached only: its row says so first.
+      for (std::size_t k : scenes[s].levels)
+        if (fs::exists(solves[k].dir / "manifest.json")) {
+          std::ifstream in(solves[k].dir / "manifest.json");
+          const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
+          if (!manifest.is_discarded() && manifest.contains("stopped") && manifest.at("stopped").is_string())
+            verified.note = "L" + std::to_string(solves[k].level) + " stopped before the trajectory's end (" +
+                            manifest.at("stopped").get<std::string>().substr(0, 160) + "…); " + verified.note;
         }
       char size[64];
       std::snprintf(size, sizeof size, "mesh h = %.3g mm; ", study_reference_element_size(scene, finest_level) * 1e3);

@@ -81,7 +81,7 @@ StudySpec read_study(const std::filesystem::path& file) {
   }
   if (const toml::table* ref = doc["reference"].as_table()) {
     spec.has_reference = true;
-    allow_only(file, *ref, "reference.", {"degree", "refinements", "scene_refinements", "samples", "linear_solver", "fracture", "library"});
+    allow_only(file, *ref, "reference.", {"degree", "scene_degree", "refinements", "scene_refinements", "samples", "linear_solver", "fracture", "library"});
     if (auto d = (*ref)["degree"]) {
       const auto v = d.value<int64_t>();
       if (!v || (*v != 1 && *v != 2)) fail(file, d.node()->source(), "reference.degree", "expected 1 or 2");
@@ -113,6 +113,20 @@ StudySpec read_study(const std::filesystem::path& file) {
         if (!known) fail(file, levels.source(), "reference.scene_refinements." + scene, "expected a scene of study.scenes");
         spec.reference.scene_refinements[scene] =
             read_levels(toml::node_view<const toml::node>(&levels), "reference.scene_refinements." + scene);
+      }
+    }
+    if (auto r = (*ref)["scene_degree"]) {
+      const toml::table* t = r.as_table();
+      if (!t) fail(file, r.node()->source(), "reference.scene_degree", "expected a table { SCENE = 1 or 2 }");
+      for (const auto& [name, degree] : *t) {
+        const std::string scene(name.str());
+        const std::string key = "reference.scene_degree." + scene;
+        const bool known = std::any_of(spec.scenes.begin(), spec.scenes.end(),
+                                       [&](const std::filesystem::path& p) { return p.stem().string() == scene; });
+        if (!known) fail(file, degree.source(), key, "expected a scene of study.scenes");
+        const auto v = degree.value<int64_t>();
+        if (!v || (*v != 1 && *v != 2)) fail(file, degree.source(), key, "expected 1 or 2");
+        spec.reference.scene_degree[scene] = static_cast<int>(*v);
       }
     }
     if (auto l = (*ref)["library"]) {

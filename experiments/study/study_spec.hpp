@@ -16,6 +16,7 @@
 //   linear_solver = "auto"                         # "auto", "direct" or "iterative"
 //   fracture = "off"                               # cohesive fracture: "off", "auto" or "on"
 //   scene_refinements = { potato_rect_cut = [-3, -2, -1] }   # a scene's own levels (optional)
+//   scene_degree = { clay_pull = 2 }               # a scene's own element degree (optional)
 //
 //   [models.springs]                               # optional: a model at several resolutions,
 //   resolutions = [4, 8, 12]                       # one row "springs [N = 4]" … each (instead of the
@@ -59,6 +60,15 @@ inline constexpr int minimum_study_mesh_level = -3;
 /// Every one of them is in the reference cache's key (reference_cache.hpp).
 struct StudyReferenceSpec {
   int degree = 1;                   ///< FE_SimplexP degree, 1 or 2
+  /// Per-scene degrees replacing `degree` for the scenes named ([reference] scene_degree =
+  /// { NAME = 2 }): a nearly incompressible scene converges with quadratic elements, where linear
+  /// ones lock, while another scene of the study keeps linear ones.
+  std::map<std::string, int> scene_degree;
+  /// The element degree of the scene named `scene`: its own, else `degree`.
+  int degree_of(const std::string& scene) const {
+    const auto it = scene_degree.find(scene);
+    return it == scene_degree.end() ? degree : it->second;
+  }
   /// Mesh levels, ascending; the last is the finest. Level k >= 0: the scene's mesh refined k
   /// times (element size h/2^k); k < 0: the scene meshed anew at 2^-k h (reference_cache.hpp,
   /// study_reference_scene), a cheap coarse level. In minimum_study_mesh_level..4.
@@ -74,7 +84,7 @@ struct StudyReferenceSpec {
   }
   int samples = 40; ///< equilibrium solves along each trajectory (evenly spaced samples)
   /// Linear solver of each Newton step (reference/finite_strain_solver.hpp): "auto" (direct below
-  /// 60 000 DOFs), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
+  /// 200 000 DOFs), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
   reference::LinearSolverChoice linear_solver = reference::LinearSolverChoice::automatic;
   /// Cohesive fracture along the scene's cut_plane (experiments/reference_run/reference_fracture.hpp): "off"
   /// (default, as `kerf reference`), "auto" or "on".

@@ -618,6 +618,19 @@ double LatticeForces::lattice_forces_single(const SpringNetwork& net) noexcept {
                                   m_pad);
     cell_volume_forces_single(P, m_corner.data(), m_q_single.data(), stride, m_pad, F, F + P, F + 2 * P);
   }
+  // The anchors (a compliant grasp): f = K (a − x) + τ K (ȧ − v), with a − x = (a − X) − u from
+  // the single-precision displacement u, the difference taken in double.
+  const NodeAnchors& anchors = net.anchors;
+  for (int i = 0; i < anchors.count(); ++i) {
+    const int s = m_slot[static_cast<std::size_t>(anchors.node[static_cast<std::size_t>(i)])];
+    const double K = anchors.stiffness[static_cast<std::size_t>(i)];
+    for (int r = 0; r < 3; ++r) {
+      const auto e = static_cast<std::size_t>(r * P + s);
+      const double gap = (anchors.position(r, i) - m_rest[e]) - static_cast<double>(U[e]);
+      F[e] += static_cast<float>(K * (gap + net.damping_time * (anchors.velocity(r, i) - static_cast<double>(V[e]))));
+      energy += 0.5 * K * gap * gap;
+    }
+  }
   return energy;
 }
 
@@ -668,6 +681,9 @@ double LatticeForces::gershgorin_bound(const SpringNetwork& net, const Eigen::Ma
               m_pad);
     cell_row_ends(P, m_corner.data(), m_q.data(), stride, m_pad, R);
   }
+  // An anchor adds K I to its node's diagonal block: K to the row.
+  for (int i = 0; i < net.anchors.count(); ++i)
+    R[m_slot[static_cast<std::size_t>(net.anchors.node[static_cast<std::size_t>(i)])]] += net.anchors.stiffness[static_cast<std::size_t>(i)];
   double bound = 0.0;
   for (int p = 0; p < P; ++p) bound = std::max(bound, R[p] * m_bound_weight[static_cast<std::size_t>(p)]);
   return bound;
@@ -703,6 +719,18 @@ double LatticeForces::lattice_forces(const SpringNetwork& net) noexcept {
     energy += cell_volumes(P - m_pad, m_corner.data(), 1.0 / (4.0 * h), kappa * h * h * h, tau, m_cell.data(), X, X + P,
                            X + 2 * P, V, V + P, V + 2 * P, m_q.data(), stride, m_pad);
     cell_volume_forces(P, m_corner.data(), m_q.data(), stride, m_pad, F, F + P, F + 2 * P);
+  }
+  // The anchors (a compliant grasp): f = K (a − x) + τ K (ȧ − v).
+  const NodeAnchors& anchors = net.anchors;
+  for (int i = 0; i < anchors.count(); ++i) {
+    const int s = m_slot[static_cast<std::size_t>(anchors.node[static_cast<std::size_t>(i)])];
+    const double K = anchors.stiffness[static_cast<std::size_t>(i)];
+    for (int r = 0; r < 3; ++r) {
+      const auto e = static_cast<std::size_t>(r * P + s);
+      const double gap = anchors.position(r, i) - X[e];
+      F[e] += K * (gap + tau * (anchors.velocity(r, i) - V[e]));
+      energy += 0.5 * K * gap * gap;
+    }
   }
   return energy;
 }

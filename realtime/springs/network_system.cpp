@@ -283,6 +283,14 @@ void NetworkSystem::assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x
     for (int i = 0; i < 3; ++i)
       if (const int d = m_dof_of[static_cast<std::size_t>(3 * p + i)]; d >= 0)
         values[m_diagonal[static_cast<std::size_t>(d)]] += mass_weight * net.mass[static_cast<std::size_t>(p)];
+  // The anchors of a compliant grasp: K I on the node's diagonal block (their dashpots τ K take
+  // the springs' weight, 1 + τ/h for backward Euler).
+  for (int a = 0; a < net.anchors.count(); ++a) {
+    const int p = net.anchors.node[static_cast<std::size_t>(a)];
+    for (int i = 0; i < 3; ++i)
+      if (const int d = m_dof_of[static_cast<std::size_t>(3 * p + i)]; d >= 0)
+        values[m_diagonal[static_cast<std::size_t>(d)]] += stiffness_weight * net.anchors.stiffness[static_cast<std::size_t>(a)];
+  }
   for (std::size_t d = 0; d < m_dof_in_use.size(); ++d)
     if (!m_dof_in_use[d]) values[m_diagonal[d]] = 1.0; // an unused shadow: decoupled, solution 0
 }

@@ -259,6 +259,22 @@ double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const
       for (int a = 0; a < 8; ++a) f.col(nodes[static_cast<std::size_t>(a)]) += fc.col(a);
     }
   }
+  return energy + add_anchor_forces(net, x, v, f);
+}
+
+double add_anchor_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
+                         Eigen::Matrix3Xd& f) noexcept {
+  const NodeAnchors& anchors = net.anchors;
+  const double tau = net.damping_time;
+  double energy = 0.0;
+  for (int i = 0; i < anchors.count(); ++i) {
+    const int p = anchors.node[static_cast<std::size_t>(i)];
+    const double K = anchors.stiffness[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d gap = anchors.position.col(i) - x.col(p);
+    // f = K (a − x) + τ K (ȧ − v)
+    f.col(p) += K * (gap + tau * (anchors.velocity.col(i) - v.col(p)));
+    energy += 0.5 * K * gap.squaredNorm();
+  }
   return energy;
 }
 

@@ -47,6 +47,22 @@ struct SpringArrays {
   int count = 0;
 };
 
+/// The anchors of a compliant grasp (docs/spring-network.md §3, "Compliant grasp"): node[i] is
+/// held by a zero-length spring of stiffness stiffness[i] [N/m], with the Kelvin–Voigt dashpot
+/// τ K of the network's springs, to the point position.col(i) moving at velocity.col(i) [m, m/s]
+/// (the tool's motion):
+///   f = K (a − x) + τ K (ȧ − v)  on the node,  stored energy ½ K |a − x|².
+/// Whoever moves the tools sets position and velocity; the force loops (network_forces,
+/// LatticeForces), the stiffness matrix (NetworkSystem) and the explicit stability bounds include
+/// the anchors. Anchored nodes are free (not constrained) and never split.
+struct NodeAnchors {
+  std::vector<int> node;
+  std::vector<double> stiffness;
+  Eigen::Matrix3Xd position = Eigen::Matrix3Xd(3, 0);
+  Eigen::Matrix3Xd velocity = Eigen::Matrix3Xd(3, 0);
+  [[nodiscard]] int count() const { return static_cast<int>(node.size()); }
+};
+
 /// The network (paper 000 §2.1). Node arrays are sized for `node_capacity()` so that tearing
 /// can add copies of split vertices without allocating; nodes [0, node_count) are in use.
 /// Whoever re-points `cell_nodes` (a tear) calls `merge_springs` afterwards.
@@ -63,6 +79,7 @@ struct SpringNetwork {
   std::vector<std::uint8_t> constraint;        ///< NodeConstraint bits
   int node_count = 0;
   SpringArrays springs;                        ///< from cell_nodes by merge_springs
+  NodeAnchors anchors;                         ///< a compliant grasp's anchors (none: rigid or no grasp)
   /// Incremented by every merge_springs: a count that changes whenever the cells' corners may
   /// have (LatticeForces uses it to know the network is still the one it was built for).
   std::uint64_t topology = 0;
@@ -106,9 +123,14 @@ void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matr
 
 /// Sum of all cells' internal forces into f (3 x capacity, overwritten for nodes in use), the
 /// same forces as cell_forces summed over the cells but with the springs taken from the merged
-/// flat arrays (`net.springs`) and the volume term per cell; returns the elastic energy [J].
-/// Allocation-free.
+/// flat arrays (`net.springs`) and the volume term per cell, plus the anchors' forces
+/// (`add_anchor_forces`); returns the elastic energy [J]. Allocation-free.
 double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                       Eigen::Matrix3Xd& f) noexcept;
+
+/// Adds the anchors' forces K (a − x) + τ K (ȧ − v) (NodeAnchors) to f at their nodes; returns
+/// their energy Σ ½ K |a − x|² [J]. Allocation-free.
+double add_anchor_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
+                         Eigen::Matrix3Xd& f) noexcept;
 
 } // namespace kerf

@@ -1,6 +1,7 @@
 #include "realtime/springs/spring_network_model.hpp"
 
 #include "meshes/surface_mesh.hpp"
+#include "realtime/springs/compliant_grasp.hpp"
 #include "realtime/springs/symplectic_euler.hpp"
 
 #include <Eigen/Geometry>
@@ -133,6 +134,11 @@ SpringNetworkModel::SpringNetworkModel(const TetMesh& mesh, SpringNetworkSetup s
   const SpringNetworkSetup& s = m_setup;
   if (s.styluses.empty() || s.styluses.size() > 2)
     throw std::invalid_argument("springs: needs one or two styluses, got " + std::to_string(s.styluses.size()));
+  for (const SpringStylus& t : s.styluses) {
+    if (!(t.grasp_stiffness >= 0.0)) throw std::invalid_argument("springs: a stylus's grasp stiffness must be >= 0 N/m^3 (0: rigid)");
+    if (t.grasp_stiffness > 0.0 && (t.blade || !(t.grasp_disc_radius > 0.0)))
+      throw std::invalid_argument("springs: a compliant grasp (grasp stiffness > 0) needs a stylus with a grasp disc radius > 0 m");
+  }
   for (const SpringStylus& t : s.styluses)
     if (t.blade) {
       if (s.styluses.size() != 1) throw std::invalid_argument("springs: a blade is taken alone (one tool)");
@@ -160,8 +166,12 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   const Eigen::Vector3d extent = box_hi - box_lo;
 
   // 1. The block around the contact points.
-  std::vector<Eigen::Vector3d> contact;
-  for (const SpringStylus& t : s.styluses) contact.push_back(body.closest_point(t.start).point);
+  std::vector<Eigen::Vector3d> contact, contact_normal;
+  for (const SpringStylus& t : s.styluses) {
+    const SurfaceQuery::Closest closest = body.closest_point(t.start);
+    contact.push_back(closest.point);
+    contact_normal.push_back(closest.normal);
+  }
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (const auto& c : contact) centre += c / static_cast<double>(contact.size());
   double spread = 0.0;
@@ -218,8 +228,23 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   // 4. Nodes under each stylus tip are attached to it.
   m_attached_to.assign(static_cast<std::size_t>(net.node_capacity()), -1);
   m_gap.assign(static_cast<std::size_t>(net.node_capacity()), 0.0);
+  m_anchor_tool.clear();
+  net.anchors = NodeAnchors{};
   for (int t = 0; t < static_cast<int>(s.styluses.size()); ++t) {
     const SpringStylus& stylus = s.styluses[static_cast<std::size_t>(t)];
+    if (stylus.grasp_stiffness > 0.0) {
+      // A compliant grasp: the layer on the disc around the contact point, lumped onto anchors
+      // that start at their nodes (d − u = 0 at rest).
+      const LumpedGraspLayer lumped = lump_grasp_layer(
+          net, GraspLayer{contact[static_cast<std::size_t>(t)], contact_normal[static_cast<std::size_t>(t)], stylus.grasp_disc_radius,
+                          stylus.grasp_stiffness});
+      for (std::size_t i = 0; i < lumped.node.size(); ++i) {
+        net.anchors.node.push_back(lumped.node[i]);
+        net.anchors.stiffness.push_back(lumped.stiffness[i]);
+        m_anchor_tool.push_back(t);
+      }
+      continue;
+    }
     if (stylus.blade) {
       // The nodes under the edge: within its span and h/2 of its plane, ahead of it along c.
       const Eigen::Vector3d& e = stylus.blade->edge_direction;
@@ -271,8 +296,12 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
         m_tool_cells.push_back(cell);
         break;
       }
+  net.anchors.position.resize(3, net.anchors.count());
+  for (int i = 0; i < net.anchors.count(); ++i) net.anchors.position.col(i) = net.rest.col(net.anchors.node[static_cast<std::size_t>(i)]);
+  net.anchors.velocity.setZero(3, net.anchors.count());
   m_excluded.assign(static_cast<std::size_t>(net.node_capacity()), 0);
   for (int p = 0; p < net.node_count; ++p) m_excluded[static_cast<std::size_t>(p)] = m_attached_to[static_cast<std::size_t>(p)] >= 0;
+  for (const int p : net.anchors.node) m_excluded[static_cast<std::size_t>(p)] = 1; // anchored nodes are not split
 
   m_initial = std::move(net);
   m_omega_max = highest_angular_frequency(m_initial);
@@ -284,6 +313,17 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
 
 int SpringNetworkModel::attached_nodes(int stylus) const {
   return static_cast<int>(std::count(m_attached_to.begin(), m_attached_to.end(), stylus));
+}
+
+int SpringNetworkModel::anchored_nodes(int stylus) const {
+  return static_cast<int>(std::count(m_anchor_tool.begin(), m_anchor_tool.end(), stylus));
+}
+
+double SpringNetworkModel::anchor_stiffness(int stylus) const {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < m_anchor_tool.size(); ++i)
+    if (m_anchor_tool[i] == stylus) sum += m_initial.anchors.stiffness[i];
+  return sum;
 }
 
 void SpringNetworkModel::reset() {
@@ -321,6 +361,7 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
     for (int t = 0; t < n_tools; ++t) m_last_tool[static_cast<std::size_t>(t)] = tools[static_cast<std::size_t>(t)].position;
     m_started = true;
   }
+  const bool quasi_static = m_setup.integrator == SpringIntegrator::quasi_static;
   // Attached node target: rest + (tool position − stylus start), at fraction s of the sample.
   const auto place_attached = [&](double s) {
     for (const int p : m_attached) {
@@ -340,6 +381,17 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
       const Eigen::Vector3d target = m_net.rest.col(p) + (from + s * (to - from)) - tool.start;
       m_v.col(p) = (to - from) / dt;
       m_x.col(p) = target;
+    }
+    // A compliant grasp's anchors: a_p = X_p + d, d the stylus's displacement since its start.
+    NodeAnchors& anchors = m_net.anchors;
+    for (int i = 0; i < anchors.count(); ++i) {
+      const int t = m_anchor_tool[static_cast<std::size_t>(i)];
+      const Eigen::Vector3d& from = m_last_tool[static_cast<std::size_t>(t)];
+      const Eigen::Vector3d& to = tools[static_cast<std::size_t>(t)].position;
+      anchors.position.col(i) =
+          m_net.rest.col(anchors.node[static_cast<std::size_t>(i)]) + (from + s * (to - from)) - m_setup.styluses[static_cast<std::size_t>(t)].start;
+      // Quasi-static equilibrium has no rates (the forces are taken at zero velocity).
+      anchors.velocity.col(i) = quasi_static ? Eigen::Vector3d::Zero() : Eigen::Vector3d((to - from) / dt);
     }
   };
   bool over_budget = false;
@@ -405,6 +457,19 @@ void SpringNetworkModel::step(std::span<const ToolState> tools, double dt, std::
   } else {
     for (int p = 0; p < m_net.node_count; ++p)
       if (const int t = m_attached_to[static_cast<std::size_t>(p)]; t >= 0) forces[static_cast<std::size_t>(t)].force += m_f.col(p);
+  }
+
+  // A compliant grasp: the anchors' forces on the stylus, −[K (a − x) + τ K (ȧ − v)] each (the
+  // force the body exerts through the layer, as the attached nodes' internal forces above).
+  {
+    const NodeAnchors& anchors = m_net.anchors;
+    const double tau = m_net.damping_time;
+    for (int i = 0; i < anchors.count(); ++i) {
+      const int p = anchors.node[static_cast<std::size_t>(i)];
+      const double K = anchors.stiffness[static_cast<std::size_t>(i)];
+      forces[static_cast<std::size_t>(m_anchor_tool[static_cast<std::size_t>(i)])].force -=
+          K * ((anchors.position.col(i) - m_x.col(p)) + tau * (anchors.velocity.col(i) - m_v.col(p)));
+    }
   }
 
   if (m_tearing && finite && m_tearing->tear(m_net, m_x, m_v, m_excluded)) {

@@ -51,10 +51,18 @@ struct SpringBladeEdge {
 
 /// A tool: a stylus, its tip centre at the first sample [m] and tip radius [m]; or, with
 /// `blade`, a blade whose edge midpoint is at `start` at the first sample (radius unused).
+/// A stylus with `grasp_stiffness` k > 0 grasps compliantly (docs/spring-network.md §3,
+/// "Compliant grasp"; the scene's grasp_stiffness and grasp_radius): the disc of radius
+/// `grasp_disc_radius` a on the face the tip touches, centred at the contact point, is held to
+/// the tip by an elastic layer of stiffness per area k(r) = k (1 − r²/a²), lumped onto the
+/// network's nodes on that face as anchor springs (lump_grasp_layer); otherwise the nodes within
+/// SpringNetworkSetup::grasp_radius are attached rigidly.
 struct SpringStylus {
   Eigen::Vector3d start = Eigen::Vector3d::Zero();
   double radius = 0.0;
   std::optional<SpringBladeEdge> blade = std::nullopt;
+  double grasp_stiffness = 0.0;   ///< k [N/m³]; 0: the rigid grasp
+  double grasp_disc_radius = 0.0; ///< a [m] > 0 with grasp_stiffness
 };
 
 /// Everything the model is built from (SI units).
@@ -73,8 +81,9 @@ struct SpringNetworkSetup {
   bool single_precision_forces = true;
   bool tearing = false;
   double tensile_limit = 0.0;   ///< σ_max [Pa] > 0 when tearing
-  /// Grasp radius [m]: network nodes within it of a stylus tip centre are attached to the stylus;
-  /// 0: the tip radius plus half a cell, r + h/2.
+  /// Grasp radius [m] of the rigid grasp: network nodes within it of a stylus tip centre are
+  /// attached to the stylus; 0: the tip radius plus half a cell, r + h/2. Not used by a stylus
+  /// that grasps compliantly (SpringStylus::grasp_stiffness).
   double grasp_radius = 0.0;
   std::vector<SpringSupport> supports;
   std::vector<SpringStylus> styluses; ///< one or two
@@ -93,14 +102,19 @@ struct SpringNetworkSetup {
 /// 4. styluses: nodes within the grasp radius (r + h/2 unless given) of a tip centre (at least the
 ///    nearest one) are attached to it
 ///    and move with it (paper 000 §2.1: "the vertices at the stylus tip is fixed to the stylus").
+///    A stylus that grasps compliantly attaches none: the nodes of the face it touches whose
+///    shape functions meet its disc get anchors (lump_grasp_layer) that move with it, a_p =
+///    X_p + (p(t) − p(0)), and stay free.
 ///    A blade (one tool alone): the nodes under its edge — within the edge's span, within h/2 of
 ///    the plane of the edge and the cutting direction, in the first layer the edge meets (gap g
 ///    along the cutting direction c within h/2 of the smallest) — are attached; each stays put
 ///    until the edge reaches it and is then pushed along c: x = X + c max(0, (p − p₀)·c − g).
 ///    For a blade the block side covers the edge's span in the body, h = max(smallest extent,
 ///    that span) / N.
-/// `step`: attached nodes follow the stylus; the network is advanced by dt with the integrator;
-/// the force on each stylus is the sum of the internal forces on its attached nodes; mode is
+/// `step`: attached nodes and anchors follow the stylus; the network is advanced by dt with the
+/// integrator; the force on each stylus is the sum of the internal forces on its attached nodes
+/// (the force the body exerts on them), or for a compliant grasp the sum of its anchors' forces
+/// on the stylus, −Σ [K_p (a_p − x_p) + τ K_p (ȧ_p − v_p)]; mode is
 /// deformation-1, and rupture on the sample in which a tear separates the network into more
 /// pieces. A tear under the implicit or quasi-static integrator re-analyses the sparse pattern
 /// (the one allocation `step` may make, once per tear); the explicit integrator tears without.
@@ -125,6 +139,9 @@ public:
   [[nodiscard]] long factorisations() const { return m_factorisations; }
   [[nodiscard]] int pieces() const { return m_pieces; }   ///< connected pieces of the network
   [[nodiscard]] int attached_nodes(int stylus) const;
+  /// A compliant grasp's anchored nodes of `stylus` and the sum of their stiffnesses Σ K_p [N/m].
+  [[nodiscard]] int anchored_nodes(int stylus) const;
+  [[nodiscard]] double anchor_stiffness(int stylus) const;
 
 private:
   void build(const TetMesh& mesh);
@@ -139,6 +156,7 @@ private:
   /// the tools.
   std::vector<int> m_tool_cells;
   std::vector<double> m_gap;             ///< per node attached to a blade: its gap g [m]
+  std::vector<int> m_anchor_tool;        ///< per anchor (m_net.anchors): the stylus it moves with
   std::vector<std::uint8_t> m_excluded;  ///< per node: not torn (attached)
   Eigen::Matrix3Xd m_x, m_v, m_f;
   std::vector<Eigen::Vector3d> m_last_tool;

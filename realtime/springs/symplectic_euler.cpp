@@ -82,6 +82,9 @@ double gershgorin_frequency_bound(const SpringNetwork& net, const Eigen::Matrix3
       for (int a = 0; a < 8; ++a) work[static_cast<std::size_t>(nodes[static_cast<std::size_t>(a)])] += kappa * h * h * h * norms[a] * total;
     }
   }
+  // An anchor adds K I to its node's diagonal block: K to the row.
+  for (int i = 0; i < net.anchors.count(); ++i)
+    work[static_cast<std::size_t>(net.anchors.node[static_cast<std::size_t>(i)])] += net.anchors.stiffness[static_cast<std::size_t>(i)];
   double bound = 0.0;
   for (int p = 0; p < net.node_count; ++p)
     if (net.constraint[static_cast<std::size_t>(p)] != fix_all)

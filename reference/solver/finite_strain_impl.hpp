@@ -126,6 +126,7 @@ struct FiniteStrainSolver::Impl {
     int group = -1;         // surface group
     double stiffness = 0.0; // k [N/m^3]
     std::function<Eigen::Vector3d(const Eigen::Vector3d& X, double load)> displacement;
+    std::function<double(const Eigen::Vector3d& X)> profile; // k(X) / k; absent: 1
   };
   std::vector<Foundation> foundations;
 

@@ -1,7 +1,8 @@
 // Elastic foundations (FiniteStrainProblem::foundations): a surface held by a compliant layer to an
 // anchor that moves by d(X, λ), the compliant grasp of a stylus (docs/scenes.md "Grasp"). On the
 // foundation's faces, per unit reference area, the layer's energy is ½ k |u − d|², its traction on
-// the body t = k (d − u); so, with the face's shape functions N_a (component c_a),
+// the body t = k (d − u), k = k(X) the layer's stiffness (uniform, or the foundation's profile
+// times its stiffness); so, with the face's shape functions N_a (component c_a),
 //   f_ext,a += ∫ N_a t_{c_a} dA,   K_ab += k ∫ N_a N_b dA δ(c_a, c_b)
 // (R = f_int − f_ext, ∂R/∂u = −∂f_ext/∂u). The term is linear in u: Newton stays quadratic. The
 // faces and the traction are those of the reference configuration (a layer whose stiffness is
@@ -31,7 +32,7 @@ void FiniteStrainSolver::Impl::build_foundations(const FiniteStrainProblem& prob
     const int group = static_cast<int>(it - surface_names.begin());
     if (!(surface_area(group) > 0.0))
       throw std::invalid_argument("finite strain solver: elastic foundation surface '" + e.surface + "' has no area");
-    foundations.push_back({group, e.stiffness, e.displacement});
+    foundations.push_back({group, e.stiffness, e.displacement, e.profile});
   }
 }
 
@@ -71,17 +72,19 @@ void FiniteStrainSolver::Impl::assemble_foundations(const VectorType& state, con
           const double JxW = ffv.JxW(q);
           const Eigen::Vector3d X = to_eigen(ffv.quadrature_point(q));
           const Eigen::Vector3d u(face_u[q][0], face_u[q][1], face_u[q][2]);
+          const double k = fd.profile ? fd.stiffness * fd.profile(X) : fd.stiffness; // k(X)
+          if (!(k > 0.0)) continue;
           const Eigen::Vector3d gap = fd.displacement(X, load.load_factor) - u; // d − u
-          const Eigen::Vector3d t = fd.stiffness * gap;                         // on the body
+          const Eigen::Vector3d t = k * gap;                                    // on the body
           out.foundation_on_body[e] += t * JxW;
-          out.foundation_energy += 0.5 * fd.stiffness * gap.squaredNorm() * JxW;
+          out.foundation_energy += 0.5 * k * gap.squaredNorm() * JxW;
           for (unsigned i = 0; i < n; ++i) N[i] = ffv.shape_value_component(i, q, comp[i]);
           for (unsigned i = 0; i < n; ++i) {
             if (N[i] == 0.0) continue;
             cell_ext(i) += N[i] * t[comp[i]] * JxW;
             if (!with_matrix) continue;
             for (unsigned j = 0; j < n; ++j)
-              if (comp[j] == comp[i]) cell_K(i, j) += fd.stiffness * N[i] * N[j] * JxW;
+              if (comp[j] == comp[i]) cell_K(i, j) += k * N[i] * N[j] * JxW;
           }
         }
       }

@@ -30,13 +30,17 @@ struct Recorded {
   double top_centre_uz;  ///< displacement of the top face's centre [m]
 };
 
-// Recorded at solver_version 1.
-constexpr int recorded_version = 1;
+// Recorded at solver_version 2 (the contact values unchanged since version 1).
+constexpr int recorded_version = 2;
 constexpr Recorded recorded[] = {
     {LawKind::neo_hookean, 0.2e-3, 0.016255006743663546, 3.6468403499959687e-08, -1.7448232701213008e-05},
     {LawKind::neo_hookean, 0.4e-3, 0.1835432044673154, 3.4721048657634074e-06, -0.00019462096659265718},
     {LawKind::st_venant_kirchhoff, 0.4e-3, 0.17676095380131837, 3.2725081859276789e-06, -0.00019636260260258014},
 };
+
+// The compliant grasp's case (below), recorded at the same version.
+constexpr double recorded_foundation_force_z = -1.6601101808386631;
+constexpr double recorded_foundation_top_uz = 0.00095331844521650069;
 
 constexpr double tolerance = 1e-7; // relative
 
@@ -73,6 +77,29 @@ TEST(SolverVersion, TheReferencesOutputIsTheOneRecordedForItsVersion) {
       expect_unchanged("top-centre displacement", uz, r.top_centre_uz, r);
     }
   }
+}
+
+// The compliant grasp (ElasticFoundation with the tapered disc's profile, as reference_run builds
+// it for a scene's grasp_stiffness): the same block's top centre pulled up through the layer.
+TEST(SolverVersion, TheCompliantGraspsOutputIsTheOneRecordedForItsVersion) {
+  ASSERT_EQ(solver_version, recorded_version)
+      << "solver_version was bumped: re-record the values of this test (printed below) for the new version";
+  const double L = 0.02, a = 6e-3, k = 1e8, lift = 1e-3;
+  FiniteStrainProblem p;
+  p.mesh = test::named_box(Eigen::Vector3d(-L / 2, -L / 2, 0), Eigen::Vector3d(L / 2, L / 2, L / 2), 4, 4, 2);
+  p.materials.push_back({"body", LawKind::neo_hookean, 1e5, 0.3});
+  p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::bonded, {}, {}});
+  p.foundations.push_back({"zmax", k, [&](const Eigen::Vector3d&, double load) { return Eigen::Vector3d(0, 0, load * lift); },
+                           ElasticFoundation::tapered_disc(Eigen::Vector3d(0, 0, L / 2), a)});
+  FiniteStrainSolver solver(p, SolverSettings{});
+  const EquilibriumReport e = solver.solve({1.0, Eigen::Vector3d::Zero()});
+  ASSERT_TRUE(e.converged) << e.failure;
+  ASSERT_EQ(e.foundation_forces.size(), 1u);
+  const double fz = e.foundation_forces[0].z(), uz = solver.displacement_at(Eigen::Vector3d(0, 0, L / 2)).z();
+  std::printf("[ recorded ] foundation force z %.17g, top-centre u_z %.17g\n", fz, uz);
+  const Recorded r{LawKind::neo_hookean, lift, 0.0, 0.0, 0.0};
+  expect_unchanged("foundation force", fz, recorded_foundation_force_z, r);
+  expect_unchanged("top-centre displacement", uz, recorded_foundation_top_uz, r);
 }
 
 } // namespace

@@ -87,7 +87,7 @@ const std::string picture = " --camera front --no-text --no-chart --width 800 --
 } // namespace
 
 // clay_pull (experiments/scenes/clay_pull.toml): a 40 x 40 x 20 mm block, the stylus pulls the
-// top centre (x = 20 mm) up 8 mm in 1.6 s. The spring network is built around the stylus only
+// top centre (x = 20 mm) up 6 mm in 1.6 s. The spring network is built around the stylus only
 // (8 cells of 2.5 mm: x in [10, 30] mm, spring_network_model.hpp) and fine nodes outside it keep
 // their rest positions (paper 000 §2.1, network_embedding.hpp): outside the network, widened by
 // one element (2.5 mm, the scene's element size) whose colour interpolates from a moved node,

@@ -218,7 +218,7 @@ TEST(ReferenceRun, AdaptiveSamplingInsertsSamplesWhereTheCurveBendsAndMatchesAPl
   // The pull starts at t = 0: the first sample after it is within the minimum travel (0.05 mm).
   EXPECT_LE((adaptive.rows[1].position - adaptive.rows[0].position).norm(), s.adaptive_min_travel + 1e-12);
   EXPECT_GT(adaptive.rows[1].force.norm(), 0.0);
-  // The end of the pull (t = 1.6 s, clay_pull.toml: 8 mm at 5 mm/s) is a kink: a sample lies within
+  // The end of the pull (t = 1.6 s, clay_pull.toml: 6 mm at 3.75 mm/s) is a kink: a sample lies within
   // 0.1 s of it on each side, where the 4 requested samples are 0.87 s apart.
   bool before_kink = false, after_kink = false;
   for (const ProfileRow& r : adaptive.rows) {

@@ -241,9 +241,13 @@ TEST(Scenes, ClayPullIsDeformationOnly) {
   EXPECT_FALSE(s.fracture.has_value());
   const Tool& stylus = only_tool(s);
   EXPECT_EQ(stylus.kind, Tool::Kind::sphere);
-  // touching the centre of the 40 x 40 x 20 mm block's top, pulled straight up 8 mm
+  // touching the centre of the 40 x 40 x 20 mm block's top, pulled straight up 6 mm, grasping a
+  // 4 mm disc through a compliant layer
   expect_vec(stylus.trajectory.start, 0.020, 0.0, 0.020 + stylus.radius);
-  expect_vec(stylus.trajectory.segments[0].target, 0.020, 0.0, 0.030);
+  expect_vec(stylus.trajectory.segments[0].target, 0.020, 0.0, 0.028);
+  ASSERT_TRUE(stylus.grasp_radius && stylus.grasp_stiffness);
+  EXPECT_DOUBLE_EQ(*stylus.grasp_radius, 0.004);
+  EXPECT_DOUBLE_EQ(*stylus.grasp_stiffness, 1.9e9);
   EXPECT_EQ(stylus.trajectory.segments.back().kind, TrajectorySegment::Kind::dwell);
 }
 

@@ -26,7 +26,7 @@ Scene clay_pull() { return read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.tom
 ReferenceRunSettings settings_of(const Scene& scene, const StudyReferenceSpec& spec, int level) {
   std::size_t n = 0;
   for (const auto& t : sample_scene_trajectories(scene)) n = std::max(n, t.samples.size());
-  return study_reference_settings(spec, level, reference_sample_indices(n, spec.samples));
+  return study_reference_settings(spec, scene, level, reference_sample_indices(n, spec.samples));
 }
 
 } // namespace
@@ -36,8 +36,12 @@ TEST(ReferenceCache, StudySettingsCarryTheSpecAndNeverDistribute) {
   spec.degree = 2;
   spec.linear_solver = reference::LinearSolverChoice::iterative;
   spec.fracture = ReferenceFracture::automatic;
-  const ReferenceRunSettings s = study_reference_settings(spec, 3, {0, 5, 9});
+  const ReferenceRunSettings s = study_reference_settings(spec, clay_pull(), 3, {0, 5, 9});
   EXPECT_EQ(s.degree, 2);
+  // A scene's own degree ([reference] scene_degree) replaces the study's for that scene only.
+  spec.scene_degree["clay_pull"] = 1;
+  EXPECT_EQ(study_reference_settings(spec, clay_pull(), 3, {0}).degree, 1);
+  EXPECT_EQ(study_reference_settings(spec, read_scene(fs::path(KERF_SCENES_DIR) / "potato_rect_cut.toml"), 3, {0}).degree, 2);
   EXPECT_EQ(s.refinements, 3);
   EXPECT_EQ(s.sample_indices, (std::vector<std::size_t>{0, 5, 9}));
   EXPECT_EQ(s.linear_solver, reference::LinearSolverChoice::iterative);

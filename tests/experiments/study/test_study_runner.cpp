@@ -36,12 +36,15 @@ fs::path write_study(const std::string& name, const std::string& text) {
 TEST(StudySpec, ReadsScenesModelsAndReference) {
   const StudySpec s = read_study(write_study("ok.toml", "[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\n"
                                                         "models = [\"fracture\"]\n[reference]\ndegree = 2\n"
-                                                        "refinements = [0, 1, 2]\nsamples = 12\n"));
+                                                        "refinements = [0, 1, 2]\nsamples = 12\n"
+                                                        "scene_degree = { potato_rect_cut = 1 }\n"));
   EXPECT_EQ(s.name, "t");
   ASSERT_EQ(s.scenes.size(), 1u);
   EXPECT_EQ(s.scenes[0].filename(), "potato_rect_cut.toml");
   EXPECT_TRUE(s.has_reference);
   EXPECT_EQ(s.reference.degree, 2);
+  EXPECT_EQ(s.reference.degree_of("potato_rect_cut"), 1); // its own degree
+  EXPECT_EQ(s.reference.degree_of("clay_pull"), 2);       // the study's
   EXPECT_EQ(s.reference.refinements, (std::vector<int>{0, 1, 2}));
   EXPECT_EQ(s.reference.samples, 12);
 }
@@ -63,6 +66,12 @@ TEST(StudySpec, ErrorsNameFileLineColumnAndKey) {
       {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
        "scene_refinements = { potato_rect_cut = [0, -1] }\n",
        ":6:45: reference.scene_refinements.potato_rect_cut"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
+       "scene_degree = { potato_rect_cut = 3 }\n",
+       ":6:36: reference.scene_degree.potato_rect_cut"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
+       "scene_degree = { clay_pull = 2 }\n",
+       ":6:30: reference.scene_degree.clay_pull"},
   };
   int k = 0;
   for (const auto& [text, expected] : cases) {
@@ -574,6 +583,33 @@ TEST(StudyRunner, AFitAgainstAForcelessReferenceSaysWhy) {
   EXPECT_EQ(r.rows[2].note.rfind("not calibrated: ", 0), 0u) << r.rows[2].note;
 }
 
+TEST(StudyRunner, AReferenceThatStoppedShortSaysSoOnItsRow) {
+  // A reference whose load path stopped before the trajectory's end (run_reference writes the reason
+  // into its manifest's `stopped` and the profile up to the last converged sample) is verified and
+  // scored on the samples it reached only: the reference row says so before anything else.
+  const fs::path dir = fs::temp_directory_path() / ("kerf_test_study_stopped_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const StudySpec spec = read_study(write_study(
+      "stopped.toml", "[study]\nname = \"stopped\"\nscenes = [\"potato_wedge_cut\"]\nmodels = [\"fracture\"]\n"
+                      "[reference]\nrefinements = [0]\nsamples = 6\n"));
+  const ReferenceRunner stops_half_way = [](const Scene& scene, const StudyReferenceSpec&, int,
+                                            const std::vector<std::size_t>& indices, const fs::path& out) {
+    const TetMesh mesh = scene_mesh(scene);
+    BuiltModel built = make_model("fracture", scene, mesh);
+    const std::vector<std::size_t> reached(indices.begin(), indices.begin() + static_cast<long>(indices.size() / 2));
+    fs::create_directories(out);
+    std::ofstream(out / "manifest.json") << R"({"stopped": "load path: sample 9 did not converge after 6 cut-backs"})";
+    return subsample(run_model(*built.model, {scene.tools.front().name}, sample_scene_trajectories(scene)), reached);
+  };
+  const StudyResult r = run_study(spec, dir, stops_half_way);
+  ASSERT_FALSE(r.rows.empty());
+  EXPECT_EQ(r.rows[0].model, "reference L0");
+  EXPECT_NE(r.rows[0].note.find("L0 stopped before the trajectory's end (load path: sample 9 did not converge"),
+            std::string::npos)
+      << r.rows[0].note;
+  fs::remove_all(dir);
+}
+
 TEST(StudyRunner, NoFitToTheUncutReferenceOfACuttingScene) {
   // potato_rect_cut cuts; with [reference] fracture = "off" its reference is an uncut body, and a
   // cutting model fitted to it would be fitted to that. The row says so, and the calibration
@@ -594,7 +630,7 @@ TEST(StudyRunner, NoFitToTheUncutReferenceOfACuttingScene) {
 }
 
 TEST(StudyRunner, TheCalibrationTrajectoryIsTheSamePathPlayedFaster) {
-  // clay_pull: a 8 mm pull at 5 mm/s (1.6 s) and a 1 s hold. Played 4 times as fast: 0.4 s + 0.25 s,
+  // clay_pull: a 6 mm pull at 3.75 mm/s (1.6 s) and a 1 s hold. Played 4 times as fast: 0.4 s + 0.25 s,
   // through the same positions (the end point, and the point half way up the pull).
   const Scene scene = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
   const Scene fast = calibration_scene(scene, 4.0);
@@ -602,7 +638,7 @@ TEST(StudyRunner, TheCalibrationTrajectoryIsTheSamePathPlayedFaster) {
   EXPECT_NEAR(a.duration(), 2.6, 1e-9);
   EXPECT_NEAR(b.duration(), 0.65, 1e-9);
   EXPECT_LT((a.samples.back().position - b.samples.back().position).norm(), 1e-12);
-  EXPECT_LT((a.samples[800].position - b.samples[200].position).norm(), 1e-9); // t = 0.8 s and 0.2 s: 4 mm up
+  EXPECT_LT((a.samples[800].position - b.samples[200].position).norm(), 1e-9); // t = 0.8 s and 0.2 s: 3 mm up
   EXPECT_THROW(calibration_scene(scene, 0.0), std::invalid_argument);
 }
 

@@ -64,6 +64,25 @@ TEST(RealtimeContract, SpringNetworkStepAllocatesNothing) {
   }
 }
 
+TEST(RealtimeContract, CompliantGraspAllocatesNothing) {
+  // The compliant grasp (anchors on the top face, k = 1.9e9 N/m^3, a = 4 mm) through a pull and
+  // hold, with every integrator.
+  const TetMesh mesh = test::clay_pull_mesh();
+  for (const SpringIntegrator integrator :
+       {SpringIntegrator::symplectic_euler, SpringIntegrator::implicit_euler, SpringIntegrator::quasi_static,
+        SpringIntegrator::linearly_implicit_euler}) {
+    SpringNetworkSetup s = test::clay_pull_setup(integrator);
+    s.styluses[0].grasp_stiffness = 1.9e9;
+    s.styluses[0].grasp_disc_radius = 4e-3;
+    SpringNetworkModel model(mesh, s);
+    ASSERT_GT(model.anchored_nodes(0), 0);
+    std::vector<std::vector<ToolState>> path(301, std::vector<ToolState>(1));
+    for (int k = 0; k <= 300; ++k) path[static_cast<std::size_t>(k)][0].position = {0.02, 0.0, 0.022 + 5e-6 * std::min(k, 200)};
+    EXPECT_EQ(allocations_while_stepping(model, 300, [&](int k) -> const std::vector<ToolState>& { return path[static_cast<std::size_t>(k)]; }), 0)
+        << to_string(integrator);
+  }
+}
+
 TEST(RealtimeContract, BladePressAllocatesNothing) {
   // The deformation phase of a cutting scene: a blade edge pressed 1.5 mm into a prism.
   const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.04, 0.01, 0.015}, 16, 8, 6);
