@@ -39,19 +39,19 @@ if [ "$job" = asan ] || [ "$job" = asan-ci ]; then # docs/reliability.md: flags,
   # the benchmarks are no tests: CI's stage does not build them
   if [ "$job" = asan-ci ]; then options=(-DKERF_BENCHMARKS=OFF); fi
 fi
-# The default job needs the kerf executable only (and what it links): a newcomer sees results
+# The default job needs the two programs only (kerf, kerf-rig, and what they link): a newcomer sees results
 # without first compiling the tests and benchmarks; the test jobs build everything.
 targets=()
-if [ "$job" = default ]; then targets=(--target kerf); fi
+if [ "$job" = default ]; then targets=(--target kerf kerf-rig); fi
 cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=$build_type "${options[@]}"
 cmake --build "$build" -j2 "${targets[@]}"
 
 case "$job" in
   default)
     cd "$here"
-    "$build/experiments/kerf" mesh potato_rect_cut
-    "$build/experiments/kerf" run potato_rect_cut --model fracture
-    "$build/experiments/kerf" study default --results-doc docs/results.md
+    "$build/apps/kerf/kerf" mesh potato_rect_cut
+    "$build/apps/kerf/kerf" run potato_rect_cut --model fracture
+    "$build/apps/kerf/kerf" study default --results-doc docs/results.md
     ;;
   test)
     cd "$build"

@@ -1,9 +1,9 @@
 // The fuzz build's model catalogue lookup (fuzz/CMakeLists.txt only; the normal build links
-// experiments/run/model_catalogue.cpp): find_model and model_catalogue answer from the catalogue's
+// experiments/models/model_catalogue.cpp): find_model and model_catalogue answer from the catalogue's
 // names (catalogue_model_names.hpp), which is all the study reader asks of them. The descriptions
 // carry the name only.
 
-#include "experiments/run/model_catalogue.hpp"
+#include "experiments/models/model_catalogue.hpp"
 #include "fuzz/catalogue_model_names.hpp"
 
 #include <vector>

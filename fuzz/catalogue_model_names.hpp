@@ -1,5 +1,5 @@
 #pragma once
-// The model names of kerf's catalogue (experiments/run/model_catalogue.cpp), for the fuzz build.
+// The model names of kerf's catalogue (experiments/models/model_catalogue.cpp), for the fuzz build.
 // The study reader checks `models = [...]` against the catalogue (find_model), but the catalogue
 // links every model builder and, through them, the meshing (gmsh) that the fuzz build leaves
 // out; the fuzz build's find_model (catalogue_lookup.cpp) answers from this list instead.

@@ -1,6 +1,6 @@
 #include "fuzz/fuzz_targets.hpp"
 
-#include "experiments/run/reference_checkpoint.hpp"
+#include "experiments/reference_run/reference_checkpoint.hpp"
 #include "fuzz/fuzz_input_file.hpp"
 
 #include <Eigen/Core>

@@ -76,7 +76,7 @@ void fuzz_parameter_file(std::span<const std::byte> data);
 /// <= 1 ms).
 void fuzz_study_table(std::span<const std::byte> data);
 
-/// Reference checkpoints (experiments/run/reference_checkpoint.hpp, read by `kerf reference
+/// Reference checkpoints (experiments/reference_run/reference_checkpoint.hpp, read by `kerf reference
 /// --resume`). Only std::runtime_error may be thrown; an accepted checkpoint has no more samples
 /// solved than requested, valid modes, and sample records that run_reference can resume from
 /// (what it reads of them is read here too: a JSON type error escaping is a finding).

@@ -24,7 +24,7 @@
 //   write_seed_corpus OUT_DIR [--study STUDY.toml]... [--results PAGE.md]... SCENE.toml...
 
 #include "experiments/profile/force_profile.hpp"
-#include "experiments/run/reference_checkpoint.hpp"
+#include "experiments/reference_run/reference_checkpoint.hpp"
 #include "experiments/scene/quantity.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "realtime/haptics/device_protocol.hpp"

@@ -21,4 +21,10 @@ using VtuField = std::pair<std::string, Eigen::MatrixXd>;
 void write_vtu(const TetMesh& mesh, const std::filesystem::path& vtu,
                const std::vector<VtuField>& point_data = {}, const std::vector<VtuField>& cell_data = {});
 
+/// A .vtu writer as a value: write_vtu's signature. Code that must not link VTK (the model
+/// builders, which the rig links) writes its meshes through the writer its caller passes, and
+/// the research side passes `&write_vtu`.
+using VtuWriter = void (*)(const TetMesh& mesh, const std::filesystem::path& vtu,
+                           const std::vector<VtuField>& point_data, const std::vector<VtuField>& cell_data);
+
 } // namespace kerf

@@ -1,6 +1,6 @@
 #pragma once
 // A live session with the view beside it (`kerf view SCENE --model M`): the servo loop runs the
-// model wrapped in a ViewedModel on its own thread(s), exactly as `kerf haptic` runs it, while
+// model wrapped in a ViewedModel on its own thread(s), exactly as `kerf-rig haptic` runs it, while
 // the calling thread renders the newest ViewFrame at display rate. The render thread never
 // touches the model and the servo thread never waits for the render thread.
 

@@ -7,7 +7,7 @@
 //              reserved ModelState (allocation-free, lock-free, bounded: the servo's rules);
 //   geometry — in the render thread, turns a captured ViewFrame into BodyGeometry (allocates).
 
-#include "experiments/run/model_catalogue.hpp"
+#include "experiments/models/model_catalogue.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "realtime/tool_model.hpp"
 #include "viewer/body_geometry.hpp"

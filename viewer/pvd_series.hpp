@@ -1,8 +1,8 @@
 #pragma once
 // A ParaView collection (.pvd) of unstructured-grid steps with point data "displacement", as the
-// reference run writes it (fields.pvd + fields/step_NNNN.vtu, experiments/run/reference_run.cpp)
+// reference run writes it (fields.pvd + fields/step_NNNN.vtu, experiments/reference_run/reference_run.cpp)
 // or a model writes its own (the spring network's springs.pvd + springs/frame_NNNN.vtu,
-// experiments/run/springs_builder.cpp): the times, and each step read on demand (VTK's XML parser
+// experiments/models/springs_builder.cpp): the times, and each step read on demand (VTK's XML parser
 // and reader) at its deformed positions.
 
 #include <vtkDataSet.h>

@@ -1,7 +1,8 @@
 #include "viewer/recorded_run.hpp"
 
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/records/content_hash.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "viewer/offline_stepping.hpp"
 #include "viewer/viewed_model.hpp"

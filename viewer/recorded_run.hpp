@@ -6,7 +6,7 @@
 // tool samples the profile recorded, snapshotted at evenly spaced times.
 
 #include "experiments/profile/force_profile.hpp"
-#include "experiments/run/model_catalogue.hpp"
+#include "experiments/models/model_catalogue.hpp"
 #include "experiments/scene/scene.hpp"
 #include "viewer/body_view.hpp"
 #include "viewer/model_adapter.hpp"

@@ -8,8 +8,8 @@
 //
 //   ./build/experiments/benchmarks/bench_edge
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"

@@ -9,9 +9,9 @@
 //   ./build/experiments/benchmarks/bench_haptics_session
 //   ./build/experiments/benchmarks/bench_haptics_session --benchmark_filter='fracture/4000'
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "realtime/haptics/device_emulator.hpp"
 #include "realtime/haptics/servo_loop.hpp"

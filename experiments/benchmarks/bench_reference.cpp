@@ -11,8 +11,8 @@
 // assembly_s and linear_s per load step; peak_rss_MB = the process's maximum resident set so far
 // (getrusage; it only grows, so read it per benchmark in the order they run).
 
-#include "experiments/run/reference_run.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/reference_run/reference_run.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"

@@ -4,7 +4,7 @@
 //
 //   ./build/experiments/benchmarks/bench_surface_query
 
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "meshes/surface_mesh.hpp"
 

@@ -8,9 +8,9 @@
 //
 //   ./build/experiments/benchmarks/bench_voxel_step
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "meshes/surface_mesh.hpp"
 #include "realtime/voxel/local_voxel_grid.hpp"

@@ -1,6 +1,6 @@
 #include "experiments/calibration/calibration.hpp"
 
-#include "experiments/run/run_model.hpp"
+#include "experiments/models/run_model.hpp"
 #include "experiments/study/profile_metrics.hpp"
 #include "experiments/study/study_runner.hpp"
 

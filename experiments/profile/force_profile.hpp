@@ -50,11 +50,4 @@ double tool_work(const ForceProfile& profile, const std::string& tool, std::size
 /// Writes `manifest` as pretty JSON to `path` atomically.
 void write_manifest(const nlohmann::json& manifest, const std::filesystem::path& path);
 
-/// Lower-case hex SHA-256 (FIPS 180-4, through OpenSSL) of a file's bytes, e.g. the scene file
-/// hash of every manifest. Throws std::runtime_error if the file cannot be read.
-std::string file_sha256(const std::filesystem::path& file);
-
-/// Lower-case hex SHA-256 of `text` (64 digits), e.g. the study's reference cache key.
-std::string text_sha256(const std::string& text);
-
 } // namespace kerf

@@ -1,6 +1,6 @@
 #include "experiments/study/model_resolution.hpp"
 
-#include "experiments/run/model_catalogue.hpp"
+#include "experiments/models/model_catalogue.hpp"
 
 #include <cmath>
 #include <stdexcept>

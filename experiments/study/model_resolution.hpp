@@ -2,7 +2,7 @@
 // A fast model at another resolution (one point of its speed/accuracy trade each): a study file's
 // `[models.NAME] resolutions = [...]` runs the model once per value, each a point of its
 // speed/accuracy curve. The knob of each model, set on the scene the model is built from (its
-// builder reads it there; experiments/run/*_builder.cpp):
+// builder reads it there; experiments/models/*_builder.cpp):
 //
 //   springs   N, the cells per side of the network's block (paper 000 §2.1; [models.springs] cells).
 //             A scene that fixes the cell size too keeps the block's extent: cell size × N stays.

@@ -11,7 +11,7 @@
 // reference bumps whenever its numbers change: a profile cached by another version has another
 // key, so it is recomputed, never read.
 
-#include "experiments/run/reference_run.hpp"
+#include "experiments/reference_run/reference_run.hpp"
 #include "experiments/scene/scene.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "reference/solver_version.hpp"

@@ -1,8 +1,8 @@
 #include "experiments/study/stability_sweep.hpp"
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 
 #include <algorithm>
 #include <cmath>

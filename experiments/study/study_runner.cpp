@@ -1,9 +1,10 @@
 #include "experiments/study/study_runner.hpp"
+#include "experiments/records/run_record.hpp"
 
 #include "experiments/calibration/calibration.hpp"
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/reference_run.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/reference_run/reference_run.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/machine_label.hpp"
 #include "experiments/study/model_resolution.hpp"

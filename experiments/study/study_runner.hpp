@@ -4,7 +4,7 @@
 // reference, the reference's own discretisation error beside them, tables and plots (docs/studies.md).
 
 #include "experiments/profile/force_profile.hpp"
-#include "experiments/run/run_model.hpp"
+#include "experiments/models/run_model.hpp"
 #include "experiments/study/profile_metrics.hpp"
 #include "experiments/study/reference_verification.hpp"
 #include "experiments/study/study_spec.hpp"
@@ -25,7 +25,7 @@ using ReferenceRunner = std::function<ForceProfile(const Scene& scene, const Stu
                                                    int refinement, const std::vector<std::size_t>& sample_indices,
                                                    const std::filesystem::path& dir)>;
 
-/// The finite-element reference (reference/, through experiments/run/reference_run.hpp) as a
+/// The finite-element reference (reference/, through experiments/reference_run/reference_run.hpp) as a
 /// study calls it: the chosen samples at the given mesh level with the study's solver settings
 /// (study_reference_settings, reference_cache.hpp), no field files (`kerf reference` writes those).
 ReferenceRunner finite_element_reference();
@@ -145,7 +145,7 @@ struct ScoredSamples {
 };
 
 /// The phases of `reference` a model represents, given the scene's phenomena and those the model
-/// reproduces on it (represented_phenomena, experiments/run/model_catalogue.hpp). A model that
+/// reproduces on it (represented_phenomena, experiments/models/model_catalogue.hpp). A model that
 /// represents every way the scene's body comes apart (cutting, tearing) — or a scene that declares
 /// none — is scored on every sample. Otherwise it is scored on the phase before the body separates:
 /// the samples before the reference's first sample in `rupture`, `cutting` or `deformation-2` mode

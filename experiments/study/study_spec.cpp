@@ -1,7 +1,7 @@
 #include "experiments/study/study_spec.hpp"
 
 #include "experiments/calibration/free_parameters.hpp"
-#include "experiments/run/model_catalogue.hpp"
+#include "experiments/models/model_catalogue.hpp"
 #include "experiments/study/model_resolution.hpp"
 
 #include <toml++/toml.h>

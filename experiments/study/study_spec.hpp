@@ -42,7 +42,7 @@
 //
 // Unknown keys and wrong types are errors naming file:line:column, as for scenes.
 
-#include "experiments/run/reference_fracture.hpp"
+#include "experiments/reference_run/reference_fracture.hpp"
 #include "reference/finite_strain_solver.hpp"
 
 #include <filesystem>
@@ -86,7 +86,7 @@ struct StudyReferenceSpec {
   /// Linear solver of each Newton step (reference/finite_strain_solver.hpp): "auto" (direct below
   /// 60 000 DOFs, and above while the Cholesky factor stays small), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
   reference::LinearSolverChoice linear_solver = reference::LinearSolverChoice::automatic;
-  /// Cohesive fracture along the scene's cut_plane (experiments/run/reference_fracture.hpp): "off"
+  /// Cohesive fracture along the scene's cut_plane (experiments/reference_run/reference_fracture.hpp): "off"
   /// (default, as `kerf reference`), "auto" or "on".
   ReferenceFracture fracture = ReferenceFracture::off;
   /// The reference library ([reference] library, a folder relative to the study file): solved

@@ -3,11 +3,11 @@
 # `kerf view --screenshot`, off screen: under the X display in DISPLAY, else under a private Xvfb
 # (xvfb-run). Never edit the pictures by hand; rerun this script.
 #
-#   bash experiments/viewer/make_pictures.sh            # build/experiments/kerf
+#   bash experiments/viewer/make_pictures.sh            # build/apps/kerf/kerf
 #   KERF=/path/to/kerf bash experiments/viewer/make_pictures.sh
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-kerf="${KERF:-$here/build/experiments/kerf}"
+kerf="${KERF:-$here/build/apps/kerf/kerf}"
 out="$here/docs/pictures"
 runs="${RUNS_DIR:-$here/runs/pictures}"
 mkdir -p "$out" "$runs"

@@ -10,7 +10,7 @@
 # The viewed sessions use the X display in DISPLAY, else a private Xvfb started here.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
-kerf="${KERF:-$here/build/experiments/kerf}"
+kerf="${KERF:-$here/build/apps/kerf/kerf}"
 scene="$1" model="$2" extra="$3" pairs="${4:-8}"
 if [ -z "${DISPLAY:-}" ]; then
   Xvfb :97 -screen 0 1600x1200x24 -nolisten tcp -noreset >/dev/null 2>&1 &

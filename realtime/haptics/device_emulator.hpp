@@ -1,6 +1,6 @@
 #pragma once
 // An emulated device speaking kerf's device protocol (docs/device-protocol.md) from the device
-// side, for `kerf device-sim` and the loopback tests: it listens on a UDP port, runs a
+// side, for `kerf-rig device-sim` and the loopback tests: it listens on a UDP port, runs a
 // SimulatedHand following a target trajectory under the forces the rig commands, sends its
 // state at a fixed rate to the rig (whose address it learns from the rig's commands), and
 // records every force command it accepted.

@@ -1,7 +1,7 @@
 #pragma once
 // kerf's device protocol (docs/device-protocol.md): versioned little-endian UDP datagrams with
 // sequence numbers and timestamps, in both directions. A device (or a bridge beside a vendor SDK,
-// or `kerf device-sim`) sends DeviceStatePacket; the rig answers with ForceCommandPacket. This
+// or `kerf-rig device-sim`) sends DeviceStatePacket; the rig answers with ForceCommandPacket. This
 // file is the byte layout and the checks every received datagram passes before it is used.
 
 #include <Eigen/Core>

@@ -1,7 +1,7 @@
 #pragma once
 // What a haptic device declares about itself, as plain data (CHAI3D's cHapticDeviceInfo, the kerf
 // way: SI units in the names' docs), and the table of devices kerf knows by name, so that a user
-// who names the device (`kerf haptic --device-model touch`) gets its limits rather than another
+// who names the device (`kerf-rig haptic --device-model touch`) gets its limits rather than another
 // device's. Every number comes from the source named in its row (docs/haptic-rig.md, "Devices").
 
 #include <array>

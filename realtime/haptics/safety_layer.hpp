@@ -28,7 +28,7 @@ struct SafetyLimits {
   double watchdog_timeout = 0.0; ///< [s] a device state this old or older is silence: force is zeroed
 };
 
-/// The rig's safety defaults, defined here once (`kerf haptic`, `kerf view --device`, the tests):
+/// The rig's safety defaults, defined here once (`kerf-rig haptic`, `kerf view --device`, the tests):
 ///   - max_force 8.5 N: the default device's maximum force (default_device_model, device_table);
 ///   - max_force_rate 1000 N/s: the full 8.5 N in 8.5 ms, no step a hand feels as a blow;
 ///   - ramp_time 0.2 s: force fades in and out over 200 servo ticks at 1 kHz;

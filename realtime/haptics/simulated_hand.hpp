@@ -1,5 +1,5 @@
 #pragma once
-// The simulated hand of `kerf device-sim`: the device's handle held by an arm modelled as a
+// The simulated hand of `kerf-rig device-sim`: the device's handle held by an arm modelled as a
 // point mass on a spring–damper that pulls it toward the target the hand means to follow,
 //   m x'' = k (x_t - x) + b (v_t - v) + F_device,
 // integrated with semi-implicit (symplectic) Euler, stable for sqrt(k_total / m) dt < 2.

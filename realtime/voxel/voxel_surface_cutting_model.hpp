@@ -18,7 +18,7 @@ namespace kerf {
 
 /// Parameters of the voxel/polygon cutting model (SI units). Paper 002 Table 1 gives the
 /// sponge values; how its printed units become these is the builder's business
-/// (experiments/run/voxel_builder.cpp, docs/models.md section voxel).
+/// (experiments/models/voxel_builder.cpp, docs/models.md section voxel).
 struct VoxelCuttingSetup {
   double tool_radius = 0.0;            ///< cutting-stick tip radius r [m] > 0 (also Cw of Eq. 1)
   double contact_stiffness = 0.0;      ///< elastic coefficient k_e [N/m] > 0, also E of the DCS

@@ -3,8 +3,8 @@
 // and, for each finding, what the fixed parser now says about it.
 
 #include "experiments/calibration/calibration.hpp"
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/reference_checkpoint.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/reference_run/reference_checkpoint.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/model_recommendation.hpp"
 #include "experiments/study/study_spec.hpp"

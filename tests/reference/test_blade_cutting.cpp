@@ -16,8 +16,8 @@
 // (a 0.1 mm razor never separates the faces of this law). Its wedge (15°) is 1.9 mm
 // long; the force is read from 4 mm depth, with the bevel fully inside, to the end of the cut.
 
-#include "experiments/run/reference_run.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/reference_run/reference_run.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>

@@ -12,8 +12,8 @@
 //                  while the tear is under way (docs/cohesive-fracture.md: after the last ligament
 //                  parts, the freed halves' recoil leaves the quasi-static ledger).
 
-#include "experiments/run/reference_run.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/reference_run/reference_run.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>

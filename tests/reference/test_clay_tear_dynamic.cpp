@@ -31,8 +31,8 @@
 //                  above, a second method): inertia barely changes the slow pull;
 //   equilibrium    until the tear the hands' pulls are equal and opposite (the base takes no x).
 
-#include "experiments/run/reference_run.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/reference_run/reference_run.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>

@@ -12,7 +12,7 @@
 // ghost cell or a contact point counted twice changes the force at the 1e-2 level). CG + GAMG
 // stops at a true residual of 1e-10 |b| per Newton step; it is compared at 1e-6.
 
-#include "experiments/run/reference_run.hpp"
+#include "experiments/reference_run/reference_run.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"
@@ -182,7 +182,7 @@ TEST(Distributed, FieldsArePiecesPerProcess) {
   EXPECT_NE(text.find("von_mises"), std::string::npos);
 }
 
-/// The scene run (experiments/run/reference_run): clay_pull on a coarse box, tied stylus, 4
+/// The scene run (experiments/reference_run/reference_run): clay_pull on a coarse box, tied stylus, 4
 /// samples: the profile of 2 processes is the serial one; rank 0 wrote the files.
 TEST(Distributed, ClayPullProfileMatchesSerial) {
   const Scene scene = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");

@@ -6,9 +6,9 @@
 // deadlines whatever the view does. No wall-clock threshold: the assertion is the loop's own
 // deadline count.
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "realtime/haptics/replay_device.hpp"
 #include "tests/viewer/overrun_comparison.hpp"

@@ -3,9 +3,9 @@
 // (paper 000 §2.1: fine nodes outside the spring network stay at rest, fine nodes on network
 // nodes move with them); a .pvd series reads back what kerf's own writer wrote.
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "meshes/vtu_writer.hpp"
 #include "viewer/offline_stepping.hpp"

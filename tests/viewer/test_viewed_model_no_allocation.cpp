@@ -3,9 +3,9 @@
 // contact (so every lazily filled structure is in use). The models' own steps are allocation-free
 // by their own tests; what is counted here is the step plus the snapshot.
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "tests/realtime/counting_allocator.hpp"
 #include "tests/realtime/springs/model_fixtures.hpp"

@@ -10,8 +10,8 @@
 // and far below the starting offsets (20–40 %).
 
 #include "experiments/calibration/calibration.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>

@@ -3,6 +3,7 @@
 // published test vector.
 
 #include "experiments/profile/force_profile.hpp"
+#include "experiments/records/content_hash.hpp"
 
 #include <nlohmann/json.hpp>
 

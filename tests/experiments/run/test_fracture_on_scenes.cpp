@@ -3,9 +3,9 @@
 // the sample dimensions of its §5.1: the steady cutting force J_c l (Eq. 10), l from the
 // prism's cross-section; the cutting work J_c x cut area (Eqs. 3-5 with dU = 0).
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>

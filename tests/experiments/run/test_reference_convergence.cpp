@@ -1,4 +1,4 @@
-// Mesh convergence of the reference (experiments/run/reference_convergence.hpp): clay_pull's
+// Mesh convergence of the reference (experiments/reference_run/reference_convergence.hpp): clay_pull's
 // stylus pull and the deformation phase of potato_rect_cut (the blade pressed 1.5 mm in, the
 // scene's rupture deflection estimate, before any cutting) on coarse gmsh-free boxes of the
 // scenes' sizes, refined 0, 1, 2 times (nested meshes: one boundary-value problem, h halved per
@@ -6,7 +6,7 @@
 // D_1 = max_t |F_2 − F_1| < D_0 = max_t |F_1 − F_0| (Roache 1998, §5.4); the observed order
 // log2(D_0 / D_1) is positive. The blade's force also grows with depth at every level.
 
-#include "experiments/run/reference_convergence.hpp"
+#include "experiments/reference_run/reference_convergence.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"

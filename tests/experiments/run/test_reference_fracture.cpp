@@ -1,10 +1,10 @@
-// The scene-level crack path of Reference II (experiments/run/reference_fracture.hpp): the
+// The scene-level crack path of Reference II (experiments/reference_run/reference_fracture.hpp): the
 // zone-resolution check reads the element size on the crack path, the viscous regularisation's η
 // follows from τ, and bad input is refused naming the scene.
 
-#include "experiments/run/reference_fracture.hpp"
-#include "experiments/run/reference_run.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/reference_run/reference_fracture.hpp"
+#include "experiments/reference_run/reference_run.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "reference/cohesive/cohesive_zone.hpp"
 

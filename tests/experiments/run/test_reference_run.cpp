@@ -1,9 +1,9 @@
-// The scene-level reference run (experiments/run/reference_run.hpp) on clay_pull's scene with a
+// The scene-level reference run (experiments/reference_run/reference_run.hpp) on clay_pull's scene with a
 // coarse gmsh-free box of the same size (40 × 40 × 20 mm): the stylus is tied (paper 000 §2.1),
 // the tool force balances the support reaction (global equilibrium: no other load acts on the
 // body), and a run resumed from its checkpoint gives the uninterrupted profile exactly.
 
-#include "experiments/run/reference_run.hpp"
+#include "experiments/reference_run/reference_run.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"

@@ -3,7 +3,7 @@
 // tetrahedron is positive, the physical groups are there, and `cut_plane` is conforming — each
 // of its triangles is a face of exactly two tetrahedra, one on each side of the plane.
 
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "meshes/tet_quality.hpp"
 

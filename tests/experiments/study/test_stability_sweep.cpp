@@ -1,7 +1,7 @@
 // The stability sweep: scaled scenes against the factors applied by hand, and every model in the
 // catalogue run at the extreme corners of every axis without a NaN force or a crash.
 
-#include "experiments/run/model_catalogue.hpp"
+#include "experiments/models/model_catalogue.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/stability_sweep.hpp"
 

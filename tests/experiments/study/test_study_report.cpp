@@ -6,8 +6,8 @@
 
 #include "experiments/study/study_report.hpp"
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/study/study_plots.hpp"
 #include "experiments/scene/scene_reader.hpp"

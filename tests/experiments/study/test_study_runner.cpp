@@ -5,8 +5,8 @@
 #include "experiments/study/model_resolution.hpp"
 #include "experiments/study/study_report.hpp"
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>

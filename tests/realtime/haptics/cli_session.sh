@@ -1,19 +1,22 @@
 #!/usr/bin/env bash
 # The live rig from the command line, as an experimenter runs it, over loopback:
-#  1. kerf device-sim + kerf haptic --record: the session's model forces equal an offline
+#  1. kerf-rig device-sim + kerf-rig haptic --record: the session's model forces equal an offline
 #     `kerf run --trajectory SESSION` of the same scene (to 1e-9 N, the model is deterministic);
 #  2. device-sim killed with SIGKILL mid-session: every tick whose link is as old as the 10 ms
 #     watchdog commands exactly zero, and there are such ticks;
-#  3. SIGTERM to kerf haptic is an emergency stop: it exits 0 and says so;
-#  4. --device-model: an unknown name, or --max-force above the named device's maximum, is refused.
+#  3. SIGTERM to kerf-rig haptic is an emergency stop: it exits 0 and says so;
+#  4. --device-model: an unknown name, or --max-force above the named device's maximum, is refused;
+#  5. kerf-rig replay SESSION: the recorded hand motion through the servo loop again, with the
+#     session's model and rate; the replay holds the recording's last sample once it is played, so
+#     its last position is the session's last position exactly.
 # Ports are picked by the kernel (--port 0) and read from device-sim's output, so parallel runs
-# do not collide. Usage: cli_session.sh KERF SCENE WORKDIR
+# do not collide. Usage: cli_session.sh KERF_RIG KERF SCENE WORKDIR
 set -euo pipefail
-KERF=$1 SCENE=$2 WORK=$3
+KERF_RIG=$1 KERF=$2 SCENE=$3 WORK=$4
 rm -rf "$WORK" && mkdir -p "$WORK" && cd "$WORK"
 
 start_sim() { # $1 = log file; prints the port
-  "$KERF" device-sim "$SCENE" --port 0 --hand-stiffness 3000 --hold 0.3 --tail 0.3 "${@:2}" > "$1" 2>&1 &
+  "$KERF_RIG" device-sim "$SCENE" --port 0 --hand-stiffness 3000 --hold 0.3 --tail 0.3 "${@:2}" > "$1" 2>&1 &
   SIM=$!
   for _ in $(seq 100); do grep -q "udp://" "$1" && break; sleep 0.05; done
   PORT=$(sed -n 's|.*udp://127.0.0.1:\([0-9]*\),.*|\1|p' "$1" | head -1)
@@ -27,7 +30,7 @@ wait_ticks() { # $1 = session file, $2 = rows: wait (at most 120 s) until the ri
 
 # 1. session vs offline run
 start_sim sim1.log --record received.csv
-"$KERF" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --duration 2.3 --record session.csv \
+"$KERF_RIG" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --duration 2.3 --record session.csv \
   --no-realtime > haptic1.log 2>&1
 wait $SIM
 "$KERF" run "$SCENE" --model fracture --trajectory session.csv -o offline > run.log
@@ -54,7 +57,7 @@ echo "1b. kerf reference --trajectory replays the session"
 
 # 2. SIGKILL the device mid-session
 start_sim sim2.log
-"$KERF" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --duration 6 --record killed.csv \
+"$KERF_RIG" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --duration 6 --record killed.csv \
   --no-realtime > haptic2.log 2>&1 &
 RIG=$!
 wait_ticks killed.csv 500 # the rig is live (meshing first takes a while on a loaded machine)
@@ -68,7 +71,7 @@ echo "2. killed device: zero force once the link is older than the watchdog time
 
 # 3. SIGTERM to the rig is an emergency stop
 start_sim sim3.log
-"$KERF" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --no-realtime --record estop.csv \
+"$KERF_RIG" haptic "$SCENE" --model fracture --device "udp://127.0.0.1:$PORT" --no-realtime --record estop.csv \
   > haptic3.log 2>&1 &
 RIG=$!
 wait_ticks estop.csv 300
@@ -80,10 +83,23 @@ wait $SIM || true
 echo "3. SIGTERM: emergency stop, exit 0"
 
 # 4. a named device gives its limits; an unknown one, or a clamp above the device's, is an error
-"$KERF" haptic "$SCENE" --model fracture --device udp://127.0.0.1:9 --device-model phantom > model1.log 2>&1 &&
+"$KERF_RIG" haptic "$SCENE" --model fracture --device udp://127.0.0.1:9 --device-model phantom > model1.log 2>&1 &&
   { echo "an unknown --device-model was accepted"; exit 1; }
 grep -q "unknown device model 'phantom'.*touch" model1.log || { cat model1.log; echo "no error naming the model"; exit 1; }
-"$KERF" haptic "$SCENE" --model fracture --device udp://127.0.0.1:9 --device-model touch --max-force 5 > model2.log 2>&1 &&
+"$KERF_RIG" haptic "$SCENE" --model fracture --device udp://127.0.0.1:9 --device-model touch --max-force 5 > model2.log 2>&1 &&
   { echo "--max-force above the Touch's 3.3 N was accepted"; exit 1; }
 grep -q "exceeds the 3D Systems Touch's maximum force 3.3" model2.log || { cat model2.log; echo "no error naming the limit"; exit 1; }
 echo "4. --device-model: unknown names and clamps above the device's maximum are refused"
+
+# 5. the recorded session through the servo loop again
+"$KERF_RIG" replay session.csv --scene "$SCENE" --no-realtime --record replay.csv > replay.log 2>&1 ||
+  { cat replay.log; echo "replay failed"; exit 1; }
+grep -q "session ended" replay.log || { cat replay.log; echo "the replay did not end by itself"; exit 1; }
+[ "$(sed -n 2p replay.csv)" = "$(sed -n 2p session.csv)" ] ||
+  { sed -n 2p replay.csv session.csv; echo "the replay's header (rate, model, scene, tools) differs"; exit 1; }
+[ "$(tail -n 1 replay.csv | cut -d, -f4-6)" = "$(tail -n 1 session.csv | cut -d, -f4-6)" ] ||
+  { tail -n 1 replay.csv session.csv; echo "the replay does not end at the session's last position"; exit 1; }
+[ "$(tail -n +4 replay.csv | wc -l)" -ge "$(tail -n +4 session.csv | wc -l)" ] ||
+  { echo "the replay is shorter than the session"; exit 1; }
+awk -F, 'NR > 3 && $21 == "cutting" { n++ } END { exit !n }' replay.csv || { echo "the replay never cuts"; exit 1; }
+echo "5. kerf-rig replay: the session's motion again, ending at its last position"

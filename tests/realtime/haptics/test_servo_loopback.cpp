@@ -1,12 +1,12 @@
 // Live sessions over loopback UDP: the servo loop (realtime/haptics/servo_loop.hpp) driving
-// emulated devices (device_emulator.hpp) with simulated hands, as `kerf haptic` and
-// `kerf device-sim` do. Robust on a loaded 2-core machine: no assertion on wall-clock timing
+// emulated devices (device_emulator.hpp) with simulated hands, as `kerf-rig haptic` and
+// `kerf-rig device-sim` do. Robust on a loaded 2-core machine: no assertion on wall-clock timing
 // except the stated overrun tolerance (at most 10% of ticks); everything else is counts, bounds
 // and equality with an independent offline run.
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "realtime/haptics/device_emulator.hpp"
 #include "realtime/haptics/servo_loop.hpp"

@@ -5,9 +5,10 @@
 // its `displacement`) in the model's final network. Links kerf_experiments (scenes, runs) and
 // VTK (to read the files back).
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/records/run_record.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "realtime/springs/network_embedding.hpp"
 #include "realtime/springs/spring_network_model.hpp"

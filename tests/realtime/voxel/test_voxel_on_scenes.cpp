@@ -3,9 +3,9 @@
 // the scene file, and the refusal of blade scenes. Kept beside the model's own tests (this
 // program links kerf_experiments).
 
-#include "experiments/run/model_catalogue.hpp"
-#include "experiments/run/run_model.hpp"
-#include "experiments/run/scene_mesh.hpp"
+#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/run_model.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>

@@ -1,0 +1,76 @@
+// The voxel/polygon model (paper 002) built from a scene: one sphere tool (the cutting stick),
+// the body's boundary surface as its polygon, and Table 1 of [models.voxel] read as documented
+// in docs/models.md (section voxel).
+
+#include "experiments/models/model_builders.hpp"
+#include "meshes/surface_mesh.hpp"
+#include "realtime/voxel/cutting_resistance.hpp"
+#include "realtime/voxel/voxel_surface_cutting_model.hpp"
+
+namespace kerf {
+
+namespace {
+
+/// Paper 002 models a 1 mm cube with a 0.04 mm stick and gives Table 1's advance length in mm:
+/// its model's length unit is the millimetre. Table 1's "N/m^2" and "N s/m^2" are read in that
+/// unit (docs/models.md, voxel: only then do Table 1's critical forces lie within reach of the
+/// stick in the 1 mm cube) [m].
+constexpr double paper_002_length_unit = 1e-3;
+
+} // namespace
+
+void require_voxel_inputs(const Scene& scene) {
+  if (scene.tools.size() != 1 || scene.tools.front().kind != Tool::Kind::sphere)
+    throw ModelMismatch("model voxel renders the tip of one cutting stick (paper 002 §2.2, a sphere tool); scene " +
+                        scene.name + " has " + std::to_string(scene.tools.size()) + " tool(s)" +
+                        (!scene.tools.empty() && scene.tools.front().kind == Tool::Kind::blade
+                             ? ", a blade: a knife edge is outside paper 002's point-cutting model"
+                             : ""));
+  if (!scene.voxel)
+    throw ModelMismatch("model voxel needs the [models.voxel] section (paper 002 Table 1: elastic, friction and "
+                        "damping coefficients, critical forces, advance length) in " + scene.file.string());
+}
+
+BuiltModel build_voxel_model(const Scene& scene, const TetMesh& mesh) {
+  const VoxelModelSettings& t1 = *scene.voxel;
+  // Table 1 in the paper's millimetre unit: E = 20 N/mm^2 as a modulus (Eq. 1's E, with the
+  // deformed area Cw dz), the stick's contact stiffness k_e = E x 1 mm = 20 N/mm (the paper's
+  // "material stiffness" E of the DCS), damping 0.5 N s/mm^2 x 1 mm = 0.5 N s/mm.
+  const double modulus = t1.elastic_coefficient / (paper_002_length_unit * paper_002_length_unit);
+  VoxelCuttingSetup setup;
+  setup.tool_radius = scene.tools.front().radius;
+  setup.contact_stiffness = modulus * paper_002_length_unit;
+  setup.damping = t1.damping_coefficient / paper_002_length_unit;
+  setup.friction_coefficient = t1.friction_coefficient;
+  setup.critical_force_depth = t1.critical_force_depth;
+  setup.critical_force_cutting = t1.critical_force_cutting;
+  setup.advance_length = t1.advance_length;
+  setup.grid = t1.grid;
+  setup.friction = scene.phenomena.contains(Phenomenon::friction);
+  setup.depth_cutting_stiffness = t1.depth_cutting_stiffness;
+  setup.clip_friction = t1.clip_friction;
+  setup.clip_modulus = modulus;
+
+  nlohmann::json p;
+  p["table_1_length_unit_m"] = paper_002_length_unit;
+  p["tool_radius_m"] = setup.tool_radius;
+  p["contact_stiffness_N_per_m"] = setup.contact_stiffness;
+  p["damping_N_s_per_m"] = setup.damping;
+  p["friction"] = setup.friction;
+  p["friction_coefficient"] = setup.friction_coefficient;
+  p["critical_force_depth_N"] = setup.critical_force_depth;
+  p["critical_force_cutting_N"] = setup.critical_force_cutting;
+  p["advance_length_m"] = setup.advance_length;
+  p["grid_cells"] = setup.grid;
+  p["depth_cutting_stiffness"] = setup.depth_cutting_stiffness;
+  p["depth_cutting_stiffness_per_mm"] = depth_cutting_stiffness_per_mm;
+  p["clip_friction"] = setup.clip_friction;
+  p["clip_modulus_Pa"] = setup.clip_modulus;
+  p["regularisation_speed_m_per_s"] = setup.regularisation_speed;
+  p["triangle_capacity"] = setup.triangle_capacity;
+  auto model = std::make_unique<VoxelSurfaceCuttingModel>(boundary_surface(mesh), setup);
+  p["voxel_memory_bytes"] = model->voxel_memory_bytes();
+  return {std::move(model), std::move(p)};
+}
+
+} // namespace kerf
