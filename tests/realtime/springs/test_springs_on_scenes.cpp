@@ -119,16 +119,19 @@ TEST(SpringsOnScenes, ClayPullWithAGraspStiffnessGraspsCompliantly) {
   // manifest says "compliant", no node is attached rigidly, and the anchors' stiffnesses sum to
   // the layer's ∫ k (1 − r²/a²) dA = k π a²/2 (the independent value). Without the key the rigid
   // grasp is unchanged.
+  // clay_pull.toml sets k = 1.9e9 N/m^3 (its stylus's grasp_stiffness).
   Scene scene = read_scene(fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / "clay_pull.toml");
   const TetMesh mesh = scene_mesh(scene);
+  ASSERT_TRUE(scene.tools.front().grasp_radius && scene.tools.front().grasp_stiffness);
+  const double k = 1.9e9, a = *scene.tools.front().grasp_radius;
+  EXPECT_EQ(*scene.tools.front().grasp_stiffness, k);
   {
-    const BuiltModel rigid = make_model("springs", scene, mesh, {});
+    Scene rigid_scene = scene;
+    rigid_scene.tools.front().grasp_stiffness.reset();
+    const BuiltModel rigid = make_model("springs", rigid_scene, mesh, {});
     EXPECT_FALSE(rigid.parameters.contains("grasp"));
     EXPECT_GT(rigid.parameters["attached_nodes"][0].get<int>(), 0);
   }
-  ASSERT_TRUE(scene.tools.front().grasp_radius);
-  const double k = 1.9e9, a = *scene.tools.front().grasp_radius;
-  scene.tools.front().grasp_stiffness = k;
   const BuiltModel built = make_model("springs", scene, mesh, {});
   const nlohmann::json& p = built.parameters;
   ASSERT_TRUE(p.contains("grasp"));
