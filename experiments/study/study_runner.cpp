@@ -704,6 +704,13 @@ int publish_references(const std::vector<StudyReferenceSolve>& solves, const std
     write_text(entry / "command.txt", command + "\n");
     ++published;
   }
+  std::set<std::string> planned;
+  for (const StudyReferenceSolve& solve : solves) planned.insert(solve.dir.filename().string());
+  std::vector<fs::path> stale;
+  for (const fs::directory_entry& e : fs::directory_iterator(library))
+    if (e.is_directory() && fs::exists(e.path() / "key.txt") && planned.count(e.path().filename().string()) == 0)
+      stale.push_back(e.path());
+  for (const fs::path& p : stale) fs::remove_all(p);
   return published;
 }
 

@@ -124,8 +124,10 @@ std::vector<StudyReferenceSolve> study_reference_solves(const StudySpec& spec, c
 
 /// Copies each of `solves` that is in its cache (profile.csv, key.txt, manifest.json — which holds
 /// kerf's version, its git commit and the solve's settings) into `library/<key directory>/`, with
-/// `command.txt` holding `command` (what made it), replacing an entry of the same key; returns how
-/// many. The library
+/// `command.txt` holding `command` (what made it), replacing an entry of the same key, and removes
+/// every other entry of the library (a folder holding a key.txt that is not one of `solves`: an entry
+/// under a stale key, which no study run could take any more); returns how many were published. A
+/// library belongs to one study. The library
 /// is what a study file's `[reference] library` names: a study takes from it every solve whose key
 /// it holds instead of solving it (docs/studies.md, "Reference library").
 int publish_references(const std::vector<StudyReferenceSolve>& solves, const std::filesystem::path& library,

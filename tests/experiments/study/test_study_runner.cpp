@@ -610,6 +610,33 @@ TEST(StudyRunner, AReferenceThatStoppedShortSaysSoOnItsRow) {
   fs::remove_all(dir);
 }
 
+TEST(StudyRunner, PublishingReplacesTheLibrarysStaleEntries) {
+  // A library holds the study's planned solves only: publishing copies each solved one in and
+  // removes an entry under any other key (a stale one, e.g. from an older solver version), and
+  // leaves alone what is no entry (a folder without key.txt).
+  const fs::path dir = fs::temp_directory_path() / ("kerf_test_publish_" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  const fs::path library = dir / "library", cache = dir / "cache";
+  auto entry = [](const fs::path& d, const std::string& key) {
+    fs::create_directories(d);
+    std::ofstream(d / "key.txt") << key;
+    std::ofstream(d / "profile.csv") << "t,tool\n";
+  };
+  entry(cache / "planned-key", "planned");
+  entry(library / "stale-key", "stale");
+  entry(library / "planned-key", "old text of the planned key");
+  fs::create_directories(library / "notes");
+  StudyReferenceSolve solve;
+  solve.dir = cache / "planned-key";
+  EXPECT_EQ(publish_references({solve}, library, "kerf study default --publish-references"), 1);
+  EXPECT_FALSE(fs::exists(library / "stale-key"));
+  EXPECT_TRUE(fs::exists(library / "notes"));
+  std::ifstream key(library / "planned-key" / "key.txt");
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(key), {}), "planned");
+  EXPECT_TRUE(fs::exists(library / "planned-key" / "command.txt"));
+  fs::remove_all(dir);
+}
+
 TEST(StudyRunner, NoFitToTheUncutReferenceOfACuttingScene) {
   // potato_rect_cut cuts; with [reference] fracture = "off" its reference is an uncut body, and a
   // cutting model fitted to it would be fitted to that. The row says so, and the calibration
