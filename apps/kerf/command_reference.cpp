@@ -219,7 +219,7 @@ void add_reference_command(CLI::App& app) {
       {"direct", reference::LinearSolverChoice::direct},
       {"iterative", reference::LinearSolverChoice::iterative}};
   cmd->add_option("--solver", options->solver,
-                  "linear solver: auto (direct up to 60000 DOFs), direct (CHOLMOD Cholesky for a symmetric positive definite tangent, else UMFPACK LU; MUMPS under MPI) or iterative "
+                  "linear solver: auto (direct up to 60000 DOFs, and above while CHOLMOD predicts a factor of at most 1e8 entries; iterative above either), direct (CHOLMOD Cholesky for a symmetric positive definite tangent, else UMFPACK LU; MUMPS under MPI) or iterative "
                   "(PETSc CG + GAMG)")
       ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case));
   cmd->add_option("--np", options->np,
