@@ -4,6 +4,7 @@
 // body), and a run resumed from its checkpoint gives the uninterrupted profile exactly.
 
 #include "experiments/reference_run/reference_run.hpp"
+#include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/trajectory/trajectory.hpp"
@@ -77,13 +78,20 @@ TEST(ReferenceRun, ClayPullStylusIsTiedAndItsForceBalancesTheSupport) {
 }
 
 // A compliant grasp (Tool::grasp_stiffness k): the stylus holds the disc through an elastic layer,
-// and its force is the layer's, −∫ k (d − u) dA. It is the tie's in the limit k → ∞ (a penalty
+// and its force is the layer's, −∫ k(r) (d − u) dA. It is the tie's in the limit k → ∞ (a penalty
 // converges to its constraint at order 1/k: at k = 10⁴ E/h the layer's stretch is ~10⁻⁴ of the
 // body's, so the forces agree to well within 1 %); a softer layer gives a smaller force; and the
 // support alone balances the stylus (Newton's third law over the body: the layer is not a support).
+// The mesh is the scene's reference mesh at h = 10 mm, whose grasp1 conforms to the disc: the
+// layer, which ends at the disc's rim, and the tie then hold the same region.
 TEST(ReferenceRun, ClayPullCompliantGraspTendsToTheTieAndBalancesTheSupport) {
   ClayPull tied, stiff, soft;
-  const double E = tied.scene.material.youngs_modulus, h = 0.01; // the box's 10 mm cells
+  const double E = tied.scene.material.youngs_modulus, h = 0.01;
+  for (ClayPull* c : {&tied, &stiff, &soft}) {
+    c->scene.geometry.element_size = h;
+    c->mesh = scene_mesh(c->scene, MeshPurpose::reference);
+  }
+  tied.scene.tools.front().grasp_stiffness.reset(); // the scene's own grasp is compliant: tied rigidly without it
   stiff.scene.tools.front().grasp_stiffness = 1e4 * E / h;
   soft.scene.tools.front().grasp_stiffness = 1.9e9; // docs/scenes.md "Grasp": a 1 mm layer of the clay
   const ReferenceProblem rp = reference_problem(stiff.scene, stiff.mesh);
