@@ -1,5 +1,7 @@
 #include "viewer/von_mises.hpp"
 
+#include "meshes/lame_parameters.hpp"
+
 #include <Eigen/LU>
 
 #include <cmath>
@@ -15,8 +17,7 @@ Eigen::VectorXd von_mises_stress(const Eigen::MatrixXd& rest, const Eigen::Matri
                                 ", nu = " + std::to_string(poisson_ratio));
   if (rest.rows() != deformed.rows() || rest.cols() != 3 || deformed.cols() != 3)
     throw std::invalid_argument("von_mises_stress: rest and deformed must both be #P by 3");
-  const double mu = youngs_modulus / (2.0 * (1.0 + poisson_ratio));
-  const double lambda = youngs_modulus * poisson_ratio / ((1.0 + poisson_ratio) * (1.0 - 2.0 * poisson_ratio));
+  const auto [mu, lambda] = lame_parameters(youngs_modulus, poisson_ratio);
   Eigen::VectorXd out = Eigen::VectorXd::Zero(tets.rows());
   for (Eigen::Index t = 0; t < tets.rows(); ++t) {
     Eigen::Matrix3d dm, ds;

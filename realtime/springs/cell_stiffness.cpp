@@ -1,5 +1,7 @@
 #include "realtime/springs/cell_stiffness.hpp"
 
+#include "meshes/lame_parameters.hpp"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -17,8 +19,7 @@ CellIdentification identify_cell_stiffness(double youngs_modulus, double poisson
   const double E = youngs_modulus, nu = poisson_ratio, h = cell_size;
   CellIdentification id;
   // Material Lamé constants: μ = E / (2(1+ν)), λ = E ν / ((1+ν)(1−2ν)).
-  const double mu = E / (2.0 * (1.0 + nu));
-  const double lambda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+  const auto [mu, lambda] = lame_parameters(E, nu);
   double mu_springs = 0.0;
   if (volume_term) {
     if (nu < 0.25)

@@ -76,12 +76,5 @@ double von_mises(const Eigen::Matrix3d& sigma) {
   return std::sqrt(1.5 * s.cwiseProduct(s).sum());
 }
 
-LameParameters lame_parameters(double E, double nu) {
-  if (!(E > 0.0) || !std::isfinite(E))
-    throw std::invalid_argument("lame_parameters: Young's modulus must be positive and finite, got " + std::to_string(E));
-  if (!(nu > -1.0 && nu < 0.5))
-    throw std::invalid_argument("lame_parameters: Poisson's ratio must lie in (-1, 0.5), got " + std::to_string(nu));
-  return {E / (2.0 * (1.0 + nu)), E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))};
-}
 
 } // namespace kerf::reference

@@ -6,6 +6,8 @@
 // Piola–Kirchhoff stress S = 2 ∂ψ/∂C and the material tangent ℂ = 2 ∂S/∂C, from which P and 𝔸
 // follow by `first_piola_and_tangent`.
 
+#include "meshes/lame_parameters.hpp"
+
 #include <Eigen/Core>
 
 namespace kerf::reference {
@@ -52,12 +54,8 @@ Eigen::Matrix3d cauchy_stress(const Eigen::Matrix3d& F, const Eigen::Matrix3d& P
 /// Von Mises equivalent stress √(3/2 s:s), s = dev σ [Pa].
 double von_mises(const Eigen::Matrix3d& sigma);
 
-/// Lamé parameters from Young's modulus E [Pa] > 0 and Poisson's ratio ν in (-1, 0.5):
-/// μ = E / (2(1+ν)), λ = Eν / ((1+ν)(1−2ν)). Throws std::invalid_argument outside those ranges.
-struct LameParameters {
-  double mu = 0.0;     ///< shear modulus μ [Pa]
-  double lambda = 0.0; ///< first Lamé parameter λ [Pa]
-};
-LameParameters lame_parameters(double youngs_modulus, double poisson_ratio);
+/// Lamé parameters (meshes/lame_parameters.hpp, the one definition every model shares).
+using ::kerf::LameParameters;
+using ::kerf::lame_parameters;
 
 } // namespace kerf::reference

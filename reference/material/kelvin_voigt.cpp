@@ -1,5 +1,7 @@
 #include "reference/material/kelvin_voigt.hpp"
 
+#include "meshes/lame_parameters.hpp"
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -14,8 +16,9 @@ KelvinVoigtDamping kelvin_voigt_damping(double E, double nu, double eta) {
                                 " Pa, nu = " + std::to_string(nu));
   KelvinVoigtDamping d;
   d.retardation_time = eta / E; // τ = η / E
-  d.lambda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
-  d.mu = E / (2.0 * (1.0 + nu));
+  const LameParameters lame = lame_parameters(E, nu);
+  d.lambda = lame.lambda;
+  d.mu = lame.mu;
   return d;
 }
 
