@@ -45,7 +45,7 @@ TetMesh cube(int n) {
   TetMesh m = box_tet_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, n, n, n);
   for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
     auto p = [&](int k) { return Eigen::Vector3d(m.nodes.row(m.tets(t, k))); };
-    if (signed_tet_volume(p(0), p(1), p(2), p(3)) < 0.0) std::swap(m.tets(t, 2), m.tets(t, 3));
+    if (signed_volume(p(0), p(1), p(2), p(3)) < 0.0) std::swap(m.tets(t, 2), m.tets(t, 3));
   }
   return m;
 }

@@ -41,16 +41,10 @@ FaceKey face_key(int a, int b, int c) {
 
 } // namespace
 
-double signed_tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                         const Eigen::Vector3d& d) {
-  // V = det[b - a, c - a, d - a] / 6
-  return (b - a).dot((c - a).cross(d - a)) / 6.0;
-}
-
 CuttableBody::CuttableBody(TetMesh mesh) : m_mesh(std::move(mesh)) {
   for (Eigen::Index t = 0; t < m_mesh.tets.rows(); ++t) {
     auto node = [&](int k) { return Eigen::Vector3d(m_mesh.nodes.row(m_mesh.tets(t, k))); };
-    if (!(signed_tet_volume(node(0), node(1), node(2), node(3)) > 0.0))
+    if (!(signed_volume(node(0), node(1), node(2), node(3)) > 0.0))
       throw std::invalid_argument("geometric cut: tetrahedron " + std::to_string(t) + " is inverted or flat");
   }
   m_adjacency = tet_face_adjacency(m_mesh.tets);
@@ -85,7 +79,7 @@ std::vector<double> CuttableBody::fragment_volumes() const {
   std::vector<double> v(static_cast<std::size_t>(m_fragment_count), 0.0);
   for (Eigen::Index t = 0; t < m_mesh.tets.rows(); ++t) {
     auto node = [&](int k) { return Eigen::Vector3d(m_mesh.nodes.row(m_mesh.tets(t, k))); };
-    v[static_cast<std::size_t>(m_fragment[static_cast<std::size_t>(t)])] += signed_tet_volume(node(0), node(1), node(2), node(3));
+    v[static_cast<std::size_t>(m_fragment[static_cast<std::size_t>(t)])] += signed_volume(node(0), node(1), node(2), node(3));
   }
   return v;
 }
@@ -111,7 +105,7 @@ GeometricCutReport CuttableBody::cut(const SweptSurface& surface, const Geometri
     return t < tet_count ? m_mesh.tets(t, k) : added_tets[static_cast<std::size_t>(t - tet_count)][static_cast<std::size_t>(k)];
   };
   auto volume_of = [&](int t) {
-    return signed_tet_volume(position(corner(t, 0)), position(corner(t, 1)), position(corner(t, 2)), position(corner(t, 3)));
+    return signed_volume(position(corner(t, 0)), position(corner(t, 1)), position(corner(t, 2)), position(corner(t, 3)));
   };
 
   // The surface's triangles, their unit normals, and its bounds.

@@ -4,6 +4,7 @@
 // relation updated and the object split into fragments.
 
 #include "meshes/tet_mesh.hpp"
+#include "meshes/tet_quality.hpp" // signed_volume
 #include "realtime/edge/swept_surface.hpp"
 
 #include <Eigen/Core>
@@ -80,9 +81,5 @@ private:
   std::vector<int> m_fragment;
   int m_fragment_count = 0;
 };
-
-/// Signed volume of the tetrahedron (a, b, c, d): det[b - a, c - a, d - a] / 6 [m^3].
-double signed_tet_volume(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                         const Eigen::Vector3d& d);
 
 } // namespace kerf

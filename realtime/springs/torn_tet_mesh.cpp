@@ -1,6 +1,7 @@
 #include "realtime/springs/torn_tet_mesh.hpp"
 
 #include "realtime/springs/vertex_tearing.hpp"
+#include "meshes/tet_quality.hpp"
 
 #include <Eigen/Geometry>
 
@@ -15,7 +16,7 @@ namespace {
 
 using Tet = std::array<Eigen::Vector3d, 4>;
 
-double signed_volume(const Tet& t) { return (t[1] - t[0]).dot((t[2] - t[0]).cross(t[3] - t[0])) / 6.0; }
+double signed_volume(const Tet& t) { return kerf::signed_volume(t[0], t[1], t[2], t[3]); }
 
 /// The parts of tetrahedron `t` on each side of the plane x_axis = value: exact tilings.
 void clip(const Tet& t, int axis, double value, double snap, std::vector<Tet>& below, std::vector<Tet>& above) {

@@ -25,7 +25,7 @@ TetMesh cube() {
   TetMesh m = box_tet_mesh({0.0, 0.0, 0.0}, {1.0, 1.0, 1.0}, 10, 10, 10);
   for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
     auto p = [&](int k) { return Eigen::Vector3d(m.nodes.row(m.tets(t, k))); };
-    if (signed_tet_volume(p(0), p(1), p(2), p(3)) < 0.0) std::swap(m.tets(t, 2), m.tets(t, 3));
+    if (signed_volume(p(0), p(1), p(2), p(3)) < 0.0) std::swap(m.tets(t, 2), m.tets(t, 3));
   }
   return m;
 }
@@ -44,7 +44,7 @@ void expect_sound(const CuttableBody& body, double volume) {
   double total = 0.0;
   for (Eigen::Index t = 0; t < m.tets.rows(); ++t) {
     auto p = [&](int k) { return Eigen::Vector3d(m.nodes.row(m.tets(t, k))); };
-    const double v = signed_tet_volume(p(0), p(1), p(2), p(3));
+    const double v = signed_volume(p(0), p(1), p(2), p(3));
     ASSERT_GT(v, 0.0) << "tetrahedron " << t << " inverted or flat";
     total += v;
   }
