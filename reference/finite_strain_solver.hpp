@@ -15,6 +15,7 @@
 // without them (deal.II is included only by the solver's own sources in this folder:
 // finite_strain_solver.cpp, solver/ and tangent_solver.cpp; mpi_processes.cpp includes PETSc).
 
+#include "meshes/material_law.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "reference/cohesive/cohesive_law.hpp"
 #include "reference/rigid_tool.hpp"
@@ -32,12 +33,9 @@
 
 namespace kerf::reference {
 
-/// Which hyperelastic law a region uses (one class each in reference/material/).
-enum class LawKind {
-  neo_hookean,           ///< Bonet–Wood: ψ = μ/2 (I₁−3) − μ ln J + λ/2 (ln J)² (neo_hookean.hpp)
-  decoupled_neo_hookean, ///< deal.II code gallery: ψ = μ/2 (Ī₁−3) + κ/4 (J²−1−2 ln J)
-  st_venant_kirchhoff    ///< ψ = λ/2 (tr E)² + μ E:E
-};
+/// Which hyperelastic law a region uses (one class each in reference/material/): the shared
+/// MaterialLaw (meshes/material_law.hpp) under the reference's name.
+using LawKind = ::kerf::MaterialLaw;
 
 /// The material of one gmsh physical volume.
 struct MaterialRegion {

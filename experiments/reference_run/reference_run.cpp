@@ -27,17 +27,12 @@ namespace {
 
 using reference::DisplacementBoundary;
 using reference::FiniteStrainProblem;
-using reference::LawKind;
 using reference::LoadState;
 
 reference::MaterialRegion region_of(const Material& m) {
   reference::MaterialRegion r;
   r.volume_group = m.region.empty() ? "body" : m.region;
-  switch (m.law) {
-  case MaterialLaw::neo_hookean: r.law = LawKind::neo_hookean; break;
-  case MaterialLaw::decoupled_neo_hookean: r.law = LawKind::decoupled_neo_hookean; break;
-  case MaterialLaw::st_venant_kirchhoff: r.law = LawKind::st_venant_kirchhoff; break;
-  }
+  r.law = m.law; // the one MaterialLaw (meshes/material_law.hpp)
   r.youngs_modulus = m.youngs_modulus;
   r.poisson_ratio = m.poisson_ratio;
   r.density = m.density;
