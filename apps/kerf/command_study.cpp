@@ -4,7 +4,7 @@
 
 #include "apps/kerf/commands.hpp"
 #include "experiments/scene/scene_reader.hpp"
-#include "experiments/study/blas_threads.hpp"
+#include "realtime/blas_threads.hpp"
 #include "experiments/study/study_report.hpp"
 #include "apps/kerf/study_ranks.hpp"
 #include "experiments/study/study_runner.hpp"

@@ -1,15 +1,12 @@
 #include "realtime/springs/network_system.hpp"
 
+#include "realtime/blas_threads.hpp"
 #include "realtime/springs/cholmod_view.hpp"
 #include "realtime/springs/lattice_dissection.hpp"
 #include "realtime/springs/supernodal_cholesky.hpp"
 #include "realtime/springs/vector_clones.hpp"
 
-#include <dlfcn.h>
-
 #include <algorithm>
-#include <atomic>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 
@@ -33,47 +30,6 @@ constexpr bool whole_inverted_block(int columns) { return columns <= 48; }
 constexpr std::ptrdiff_t panel_floats(int nscol, int nsrow, int c) {
   return 4 * static_cast<std::ptrdiff_t>(whole_inverted_block(nscol) ? panel_rows(nsrow - c)
                                                                       : panel_rows(nscol - c) + panel_rows(nsrow - nscol));
-}
-
-// OpenBLAS (Debian's default BLAS, openblas-pthread) fans large BLAS calls out to its thread
-// pool, which allocates per call and puts other threads on the servo's critical path. Around the
-// factorisation its thread count is set to one and then restored (the pool is not resized, so
-// that allocates nothing either). Looked up at run time: other BLAS builds have no such call.
-int (*g_blas_get_threads)() = nullptr;
-void (*g_blas_set_threads)(int) = nullptr;
-// The thread count is process-wide: with several factorisations at once (a study's parallel
-// jobs), the first to enter sets one thread and the last to leave restores the count, so no
-// factorisation runs while another has restored it (which made threaded studies' springs runs
-// differ from serial ones in the last digits).
-std::atomic<int> g_blas_users{0};
-std::atomic<int> g_blas_saved{1};
-
-/// OpenBLAS on one thread for the scope (nothing with another BLAS). Lock-free.
-class SingleThreadedBlas {
-public:
-  SingleThreadedBlas() {
-    if (!g_blas_set_threads) return;
-    if (g_blas_users.fetch_add(1) == 0) {
-      g_blas_saved = g_blas_get_threads();
-      if (g_blas_saved > 1) g_blas_set_threads(1);
-    }
-  }
-  ~SingleThreadedBlas() {
-    if (!g_blas_set_threads) return;
-    if (g_blas_users.fetch_sub(1) == 1 && g_blas_saved > 1) g_blas_set_threads(g_blas_saved);
-  }
-  SingleThreadedBlas(const SingleThreadedBlas&) = delete;
-  SingleThreadedBlas& operator=(const SingleThreadedBlas&) = delete;
-};
-
-/// Looks up OpenBLAS's thread-count calls once (absent with another BLAS).
-void find_blas_thread_calls() {
-  static std::once_flag once;
-  std::call_once(once, [] {
-    g_blas_get_threads = reinterpret_cast<int (*)()>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
-    g_blas_set_threads = reinterpret_cast<void (*)(int)>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
-    if (!g_blas_get_threads || !g_blas_set_threads) g_blas_get_threads = nullptr, g_blas_set_threads = nullptr;
-  });
 }
 
 } // namespace
@@ -588,6 +544,7 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
 bool NetworkSystem::factorize() noexcept {
   if (!m_factor) return m_factorized = dof_count() == 0;
   {
+    // OpenBLAS's pool would allocate per call and put its threads on the servo's critical path.
     const SingleThreadedBlas single;
     // LLᵀ = A, A already in the factor's order.
     m_factorized = m_numeric.factorize(supernodal_structure(*m_factor), {m_matrix.outerIndexPtr(), m_matrix.innerIndexPtr(), m_matrix.valuePtr()},

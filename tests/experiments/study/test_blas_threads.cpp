@@ -1,9 +1,9 @@
-// limit_blas_to_one_thread (experiments/study/blas_threads.hpp): with OpenBLAS loaded (Debian's
+// limit_blas_to_one_thread (realtime/blas_threads.hpp): with OpenBLAS loaded (Debian's
 // libblas.so.3 when libopenblas0-pthread is installed, as experiments/setup_and_run.sh does) its
 // own thread count reads 1 afterwards, whatever it was (one per core by default); with another
 // BLAS the call says so and changes nothing.
 
-#include "experiments/study/blas_threads.hpp"
+#include "realtime/blas_threads.hpp"
 
 #include <gtest/gtest.h>
 

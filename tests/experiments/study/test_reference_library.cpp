@@ -10,7 +10,7 @@
 // was published) is named with the command that re-publishes the library.
 
 #include "experiments/profile/force_profile.hpp"
-#include "experiments/study/blas_threads.hpp"
+#include "realtime/blas_threads.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/study/study_spec.hpp"
 
