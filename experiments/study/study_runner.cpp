@@ -550,27 +550,24 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
         verified.note = std::string("no GCI available: ") + e.what();
       }
       verified.note = failed_levels + verified.note;
-      // The finest reference's own resolution check (the cohesive zone's elements, reference_fracture.hpp):
-      // a reference that fails it says so on its row.
-      for (std::size_t k : scenes[s].levels)
-        if (solves[k].level == finest_level && fs::exists(solves[k].dir / "manifest.json")) {
-          std::ifstream in(solves[k].dir / "manifest.json");
-          const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
-          if (!manifest.is_discarded() && manifest.contains("fracture") && manifest.at("fracture").contains("warning") &&
-              manifest.at("fracture").at("warning").is_string() && !manifest.at("fracture").at("warning").get<std::string>().empty())
-            verified.note = "fails its resolution check: " + manifest.at("fracture").at("warning").get<std::string>() + "; " +
-                            verified.note;
-        }
-      // A level whose load path stopped short of the trajectory's end (its manifest's `stopped`) is
-      // verified and scored on the samples it reached only: its row says so first.
-      for (std::size_t k : scenes[s].levels)
-        if (fs::exists(solves[k].dir / "manifest.json")) {
-          std::ifstream in(solves[k].dir / "manifest.json");
-          const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
-          if (!manifest.is_discarded() && manifest.contains("stopped") && manifest.at("stopped").is_string())
-            verified.note = "L" + std::to_string(solves[k].level) + " stopped before the trajectory's end (" +
-                            manifest.at("stopped").get<std::string>().substr(0, 160) + "…); " + verified.note;
-        }
+      // From each level's manifest, read once: the finest reference's own resolution check (the
+      // cohesive zone's elements, reference_fracture.hpp), which a reference that fails says on its
+      // row; and a load path that stopped short of the trajectory's end (`stopped`), so that the
+      // level is verified and scored on the samples it reached only, which its row says first.
+      std::string resolution, stopped;
+      for (std::size_t k : scenes[s].levels) {
+        if (!fs::exists(solves[k].dir / "manifest.json")) continue;
+        std::ifstream in(solves[k].dir / "manifest.json");
+        const nlohmann::json manifest = nlohmann::json::parse(in, nullptr, false);
+        if (manifest.is_discarded()) continue;
+        if (solves[k].level == finest_level && manifest.contains("fracture") && manifest.at("fracture").contains("warning") &&
+            manifest.at("fracture").at("warning").is_string() && !manifest.at("fracture").at("warning").get<std::string>().empty())
+          resolution = "fails its resolution check: " + manifest.at("fracture").at("warning").get<std::string>() + "; ";
+        if (manifest.contains("stopped") && manifest.at("stopped").is_string())
+          stopped = "L" + std::to_string(solves[k].level) + " stopped before the trajectory's end (" +
+                    manifest.at("stopped").get<std::string>().substr(0, 160) + "…); " + stopped;
+      }
+      verified.note = stopped + resolution + verified.note;
       char size[64];
       std::snprintf(size, sizeof size, "mesh h = %.3g mm; ", study_reference_element_size(scene, finest_level) * 1e3);
       StudyRow row{scene.name, "reference L" + std::to_string(finest_level), std::nullopt, cost_statistics(*finest), size + verified.note, {}};
