@@ -153,4 +153,17 @@ FiniteStrainProblem cook_membrane_problem(TetMesh mesh, bool plane_strain) {
   return p;
 }
 
+FiniteStrainProblem affine_problem(TetMesh mesh, const Eigen::Matrix3d& G, const Eigen::Vector3d& b, LawKind law,
+                                   double E, double nu) {
+  FiniteStrainProblem p;
+  p.mesh = std::move(mesh);
+  p.materials.push_back({"body", law, E, nu});
+  DisplacementBoundary bc;
+  bc.surface = "boundary";
+  bc.kind = DisplacementBoundary::Kind::prescribed;
+  bc.displacement = [G, b](const Eigen::Vector3d& X, double load) -> Eigen::Vector3d { return load * (G * X + b); };
+  p.displacement_boundaries.push_back(bc);
+  return p;
+}
+
 } // namespace kerf::reference::test

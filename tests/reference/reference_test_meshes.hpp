@@ -39,4 +39,10 @@ FiniteStrainProblem cook_membrane_problem(TetMesh mesh, bool plane_strain = true
 /// all satisfy `on_surface`, e.g. a grid plane of a box mesh to be split into a crack path.
 void add_interior_face_group(TetMesh& mesh, const std::string& name, const std::function<bool(const Eigen::Vector3d&)>& on_surface);
 
+/// The affine patch problem: one material `body` (law, E, ν) on `mesh`, its surface group
+/// `boundary` prescribed to u = load (G X + b). Any conforming element containing the linear
+/// polynomials reproduces u = G X + b inside to round-off (Zienkiewicz & Taylor, vol. 1, §9.3).
+FiniteStrainProblem affine_problem(TetMesh mesh, const Eigen::Matrix3d& G, const Eigen::Vector3d& b, LawKind law,
+                                   double E, double nu);
+
 } // namespace kerf::reference::test

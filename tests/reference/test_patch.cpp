@@ -18,19 +18,6 @@
 namespace kerf::reference {
 namespace {
 
-FiniteStrainProblem affine_problem(TetMesh mesh, const Eigen::Matrix3d& G, const Eigen::Vector3d& b, LawKind law,
-                                   double E, double nu) {
-  FiniteStrainProblem p;
-  p.mesh = std::move(mesh);
-  p.materials.push_back({"body", law, E, nu});
-  DisplacementBoundary bc;
-  bc.surface = "boundary";
-  bc.kind = DisplacementBoundary::Kind::prescribed;
-  bc.displacement = [G, b](const Eigen::Vector3d& X, double load) -> Eigen::Vector3d { return load * (G * X + b); };
-  p.displacement_boundaries.push_back(bc);
-  return p;
-}
-
 double signed_volume(const TetMesh& mesh, Eigen::Index t) {
   const Eigen::Vector3d a = mesh.nodes.row(mesh.tets(t, 0));
   return (Eigen::Vector3d(mesh.nodes.row(mesh.tets(t, 1))) - a)
@@ -64,7 +51,7 @@ TEST_P(AffinePatch, AffineDeformationIsReproducedInside) {
   const Eigen::Vector3d b(1e-3, -2e-3, 5e-4);
   SolverSettings settings;
   settings.degree = GetParam();
-  FiniteStrainSolver solver(affine_problem(mesh, G, b, LawKind::neo_hookean, 1e6, 0.3), settings);
+  FiniteStrainSolver solver(test::affine_problem(mesh, G, b, LawKind::neo_hookean, 1e6, 0.3), settings);
   const EquilibriumReport r = solver.solve({1.0, Eigen::Vector3d::Zero()});
   ASSERT_TRUE(r.converged) << r.failure;
   for (int v : interior) {
@@ -78,29 +65,6 @@ TEST_P(AffinePatch, AffineDeformationIsReproducedInside) {
 
 INSTANTIATE_TEST_SUITE_P(Degrees, AffinePatch, ::testing::Values(1, 2));
 
-// The automatic linear solver above direct_dof_limit: direct while CHOLMOD's predicted factor fits
-// direct_factor_limit, iterative when it does not; either reproduces the affine field (the direct
-// solver to round-off, CG to its 1e-10 relative residual).
-TEST(AutomaticLinearSolver, DirectWhileThePredictedFactorFits) {
-  const TetMesh mesh = test::named_box(Eigen::Vector3d::Zero(), Eigen::Vector3d(0.03, 0.02, 0.02), 3, 3, 3);
-  Eigen::Matrix3d G;
-  G << 0.05, 0.01, 0.0, 0.0, -0.02, 0.01, 0.01, 0.0, 0.03;
-  const Eigen::Vector3d b(1e-4, 0.0, -2e-4);
-  const Eigen::Vector3d X(0.01, 0.02 / 3.0, 0.02 / 3.0); // an interior node
-  SolverSettings settings;
-  settings.direct_dof_limit = 0;
-  for (const double limit : {1e8, 1.0}) {
-    settings.direct_factor_limit = limit;
-    FiniteStrainSolver solver(affine_problem(mesh, G, b, LawKind::neo_hookean, 1e6, 0.3), settings);
-    EXPECT_EQ(solver.linear_solver_name(), limit > 1.0 ? "cholmod/umfpack" : "petsc-cg-gamg");
-    const EquilibriumReport r = solver.solve({1.0, Eigen::Vector3d::Zero()});
-    ASSERT_TRUE(r.converged) << r.failure;
-    EXPECT_LT((solver.displacement_at(X) - (G * X + b)).norm(), 1e-9 * (G * X + b).norm()) << "factor limit " << limit;
-  }
-  settings.direct_factor_limit = -1.0;
-  EXPECT_THROW(FiniteStrainSolver(affine_problem(mesh, G, b, LawKind::neo_hookean, 1e6, 0.3), settings), std::invalid_argument);
-}
-
 TEST(MacNealHarder, StressesAreExactInTheSmallStrainLimit) {
   Eigen::Matrix3d G; // u = G X: rows are the gradients of u, v, w
   G << 1.0, 0.5, 0.5, 0.5, 1.0, 0.5, 0.5, 0.5, 1.0;
@@ -109,7 +73,7 @@ TEST(MacNealHarder, StressesAreExactInTheSmallStrainLimit) {
   for (LawKind law : {LawKind::neo_hookean, LawKind::st_venant_kirchhoff}) {
     SolverSettings settings;
     settings.degree = 1;
-    FiniteStrainSolver solver(affine_problem(test::macneal_harder_patch(), G, Eigen::Vector3d::Zero(), law, 1e6, 0.25),
+    FiniteStrainSolver solver(test::affine_problem(test::macneal_harder_patch(), G, Eigen::Vector3d::Zero(), law, 1e6, 0.25),
                               settings);
     const EquilibriumReport r = solver.solve({1.0, Eigen::Vector3d::Zero()});
     ASSERT_TRUE(r.converged) << r.failure;
