@@ -19,7 +19,9 @@ ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, co
                                               const std::vector<std::size_t>& sample_indices) {
   ReferenceRunSettings settings;
   settings.degree = spec.degree_of(scene.file.stem().string());
-  settings.refinements = std::max(level, 0);
+  // Every level of a scene with a geometry is meshed anew (study_reference_scene); a ready .msh
+  // can only be refined: level k >= 0 refines it k times.
+  settings.refinements = scene.geometry.kind == SceneGeometry::Kind::msh ? std::max(level, 0) : 0;
   settings.sample_indices = sample_indices;
   settings.write_fields = false;
   settings.linear_solver = spec.linear_solver;
@@ -33,8 +35,18 @@ Scene study_reference_scene(const Scene& scene, int level) {
     throw std::invalid_argument("scene " + scene.name + ": mesh level " + std::to_string(level) + " is below " +
                                 std::to_string(minimum_study_mesh_level));
   Scene s = scene;
-  // h_k = h 2^-k: a level k < 0 is the geometry meshed anew at 2^-k h.
-  if (level < 0) s.geometry.element_size = std::ldexp(scene.geometry.element_size, -level);
+  // h_k = h 2^-k: level k is the geometry meshed anew at 2^-k h, every graded size (crack path,
+  // grasp rim) scaled with it (SceneGeometry::nominal_element_size), so the levels are the same
+  // graded mesh systematically refined. A scene whose mesh is a file has no geometry to mesh: its
+  // levels k >= 0 refine that mesh k times (study_reference_settings), and k < 0 is refused.
+  if (scene.geometry.kind == SceneGeometry::Kind::msh) {
+    if (level < 0)
+      throw std::invalid_argument("scene " + scene.name + ": mesh level " + std::to_string(level) +
+                                  " needs its geometry meshed anew, and its mesh is the file " +
+                                  scene.geometry.source.string() + "; use levels >= 0 (global refinements)");
+    return s;
+  }
+  s.geometry.element_size = std::ldexp(scene.geometry.element_size, -level);
   return s;
 }
 

@@ -10,8 +10,8 @@
 //   [reference]                                    # optional: the finite-element ground truth
 //   degree = 1
 //   refinements = [0, 1]                           # mesh levels, ascending; the last is the finest;
-//                                                  # k >= 0: the scene's mesh refined k times,
-//                                                  # k < 0: meshed at 2^-k times its element size
+//                                                  # level k: the scene meshed anew at 2^-k times
+//                                                  # its element size (a .msh scene: refined k times)
 //   samples = 40                                   # trajectory samples the reference solves
 //   linear_solver = "auto"                         # "auto", "direct" or "iterative"
 //   fracture = "off"                               # cohesive fracture: "off", "auto" or "on"

@@ -42,7 +42,7 @@ TEST(ReferenceCache, StudySettingsCarryTheSpecAndNeverDistribute) {
   spec.scene_degree["clay_pull"] = 1;
   EXPECT_EQ(study_reference_settings(spec, clay_pull(), 3, {0}).degree, 1);
   EXPECT_EQ(study_reference_settings(spec, read_scene(fs::path(KERF_SCENES_DIR) / "potato_rect_cut.toml"), 3, {0}).degree, 2);
-  EXPECT_EQ(s.refinements, 3);
+  EXPECT_EQ(s.refinements, 0); // level 3 is the geometry meshed anew (study_reference_scene), not refined
   EXPECT_EQ(s.sample_indices, (std::vector<std::size_t>{0, 5, 9}));
   EXPECT_EQ(s.linear_solver, reference::LinearSolverChoice::iterative);
   EXPECT_EQ(s.fracture, ReferenceFracture::automatic);
@@ -51,21 +51,29 @@ TEST(ReferenceCache, StudySettingsCarryTheSpecAndNeverDistribute) {
 }
 
 TEST(ReferenceCache, ALevelBelowZeroIsTheSceneMeshedCoarserAndMissesTheFinerLevelsEntry) {
-  // Level k: element size h 2^-k (study_spec.hpp). k >= 0 refines the scene's own mesh k times;
-  // k < 0 meshes it anew at 2^-k h: clay_pull's 2.5 mm (its file) becomes 5 mm at level -1.
+  // Level k: the geometry meshed anew at element size h 2^-k (study_spec.hpp): clay_pull's 2.5 mm
+  // (its file) becomes 5 mm at level -1.
   const Scene scene = clay_pull();
   const double h = scene.geometry.element_size;
   EXPECT_DOUBLE_EQ(h, 2.5e-3);
   EXPECT_DOUBLE_EQ(study_reference_scene(scene, -1).geometry.element_size, 5e-3);
   EXPECT_DOUBLE_EQ(study_reference_scene(scene, -3).geometry.element_size, 20e-3);
-  EXPECT_DOUBLE_EQ(study_reference_scene(scene, 2).geometry.element_size, h); // refined by the solve
+  EXPECT_DOUBLE_EQ(study_reference_scene(scene, 2).geometry.element_size, h / 4); // meshed anew, graded alike
   EXPECT_DOUBLE_EQ(study_reference_element_size(scene, -1), 5e-3);
   EXPECT_DOUBLE_EQ(study_reference_element_size(scene, 2), 0.625e-3);
   EXPECT_THROW(study_reference_scene(scene, -4), std::invalid_argument);
   StudyReferenceSpec spec;
   spec.samples = 6;
   EXPECT_EQ(settings_of(scene, spec, -1).refinements, 0);
-  EXPECT_EQ(settings_of(scene, spec, 2).refinements, 2);
+  EXPECT_EQ(settings_of(scene, spec, 2).refinements, 0);
+  // A scene whose mesh is a .msh file has no geometry to mesh anew: level k >= 0 refines that mesh
+  // k times, and a coarser level is refused.
+  Scene from_file = scene;
+  from_file.geometry.kind = SceneGeometry::Kind::msh;
+  from_file.geometry.source = "/data/body.msh";
+  EXPECT_DOUBLE_EQ(study_reference_scene(from_file, 2).geometry.element_size, h);
+  EXPECT_EQ(settings_of(from_file, spec, 2).refinements, 2);
+  EXPECT_THROW(study_reference_scene(from_file, -1), std::invalid_argument);
   // The coarse level's entry is not the scene's own mesh's: the element size is in the key.
   const Scene coarse = study_reference_scene(scene, -1);
   const ReferenceCacheKey k_coarse = reference_cache_key(coarse, settings_of(coarse, spec, -1));
@@ -100,7 +108,10 @@ TEST(ReferenceCache, EveryNumberChangingInputMissesTheCache) {
   // Each change below changes what the reference computes; each must give a key of its own.
   const std::pair<std::string, std::function<ReferenceCacheKey()>> changes[] = {
       {"degree", [&] { StudyReferenceSpec s = spec; s.degree = 2; return reference_cache_key(nominal, settings_of(nominal, s, 0)); }},
-      {"level", [&] { return reference_cache_key(nominal, settings_of(nominal, spec, 1)); }},
+      {"level", [&] {
+         const Scene finer = study_reference_scene(nominal, 1);
+         return reference_cache_key(finer, settings_of(finer, spec, 1));
+       }},
       {"samples", [&] { StudyReferenceSpec s = spec; s.samples = 7; return reference_cache_key(nominal, settings_of(nominal, s, 0)); }},
       {"linear solver", [&] {
          StudyReferenceSpec s = spec;
@@ -119,7 +130,8 @@ TEST(ReferenceCache, EveryNumberChangingInputMissesTheCache) {
        }},
       {"E in memory", [&] { const Scene s = scaled_scene(nominal, "stiffness", 2.0); return reference_cache_key(s, settings_of(s, spec, 0)); }},
       {"nu in memory", [&] { const Scene s = scaled_scene(nominal, "poisson", 0.49); return reference_cache_key(s, settings_of(s, spec, 0)); }},
-      {"element size", [&] { const Scene s = scaled_scene(nominal, "element_size", 0.5); return reference_cache_key(s, settings_of(s, spec, 0)); }},
+      // (x 0.8: x 0.5 is level 1, the same mesh, rightly the same key)
+      {"element size", [&] { const Scene s = scaled_scene(nominal, "element_size", 0.8); return reference_cache_key(s, settings_of(s, spec, 0)); }},
       // A faster trajectory: the same file, the same sample count, other times and positions.
       {"trajectory", [&] { const Scene s = scaled_scene(nominal, "speed", 2.0); return reference_cache_key(s, settings_of(s, spec, 0)); }},
   };
@@ -137,8 +149,11 @@ TEST(ReferenceCache, TheKeyNamesTheSolverSettings) {
   const Scene scene = clay_pull();
   StudyReferenceSpec spec;
   spec.linear_solver = reference::LinearSolverChoice::direct;
-  const std::string text = reference_cache_key(scene, settings_of(scene, spec, 1)).text;
-  for (const char* line : {"degree = 1\n", "refinements = 1\n", "linear_solver = direct\n", "fracture = off\n", "processes = 1\n",
+  // Level 1 is clay_pull's geometry meshed anew at half its element size, not its mesh refined.
+  const Scene level1 = study_reference_scene(scene, 1);
+  EXPECT_DOUBLE_EQ(level1.geometry.element_size, 0.5 * scene.geometry.element_size);
+  const std::string text = reference_cache_key(level1, settings_of(level1, spec, 1)).text;
+  for (const char* line : {"degree = 1\n", "refinements = 0\n", "linear_solver = direct\n", "fracture = off\n", "processes = 1\n",
                            "newton_relative_tolerance = ", "iterative_tolerance = ", "contact_penalty = automatic\n",
                            "max_cutbacks = ", "max_newton_iterations = ", "trajectory_sha256 = "})
     EXPECT_NE(text.find(line), std::string::npos) << line << " not in\n" << text;
