@@ -304,7 +304,7 @@ StudyPlan plan_study(const StudySpec& spec, const std::filesystem::path& out, bo
     const Scene& scene = planned.scene;
     if (with_reference)
       for (int level : spec.reference.levels_of(scene_file.stem().string()))
-        planned.levels.push_back(plan_solve(scene, level, spec.reference.samples));
+        planned.levels.push_back(plan_solve(scene, level, spec.reference.samples_of(scene_file.stem().string())));
     const std::size_t index = scenes.size();
     for (const std::string& model : spec.models) {
       PhenomenonSet represented;
@@ -348,7 +348,7 @@ StudyPlan plan_study(const StudySpec& spec, const std::filesystem::path& out, bo
           try {
             const std::vector<int>& levels = spec.reference.levels_of(scene_file.stem().string());
             run.reference = plan_solve(calibration_scene(scene, fit.speed), *std::max_element(levels.begin(), levels.end()),
-                                       fit.samples > 0 ? fit.samples : spec.reference.samples);
+                                       fit.samples > 0 ? fit.samples : spec.reference.samples_of(scene_file.stem().string()));
           } catch (const std::invalid_argument& e) {
             run.refusal = std::string("not calibrated: ") + e.what();
           }

@@ -81,7 +81,8 @@ StudySpec read_study(const std::filesystem::path& file) {
   }
   if (const toml::table* ref = doc["reference"].as_table()) {
     spec.has_reference = true;
-    allow_only(file, *ref, "reference.", {"degree", "scene_degree", "refinements", "scene_refinements", "samples", "linear_solver", "fracture", "library"});
+    allow_only(file, *ref, "reference.", {"degree", "scene_degree", "refinements", "scene_refinements", "samples", "scene_samples", "linear_solver",
+                                           "fracture", "library"});
     if (auto d = (*ref)["degree"]) {
       const auto v = d.value<int64_t>();
       if (!v || (*v != 1 && *v != 2)) fail(file, d.node()->source(), "reference.degree", "expected 1 or 2");
@@ -141,6 +142,20 @@ StudySpec read_study(const std::filesystem::path& file) {
       if (!v || *v < 2 || *v > std::numeric_limits<int>::max())
         fail(file, s.node()->source(), "reference.samples", "expected an integer in 2..2147483647");
       spec.reference.samples = static_cast<int>(*v);
+    }
+    if (auto r = (*ref)["scene_samples"]) {
+      const toml::table* t = r.as_table();
+      if (!t) fail(file, r.node()->source(), "reference.scene_samples", "expected a table { SCENE = N }");
+      for (const auto& [name, count] : *t) {
+        const std::string scene(name.str());
+        const std::string key = "reference.scene_samples." + scene;
+        const bool known = std::any_of(spec.scenes.begin(), spec.scenes.end(),
+                                       [&](const std::filesystem::path& p) { return p.stem().string() == scene; });
+        if (!known) fail(file, count.source(), key, "expected a scene of study.scenes");
+        const auto v = count.value<int64_t>();
+        if (!v || *v < 2 || *v > std::numeric_limits<int>::max()) fail(file, count.source(), key, "expected an integer in 2..2147483647");
+        spec.reference.scene_samples[scene] = static_cast<int>(*v);
+      }
     }
     if (auto s = (*ref)["linear_solver"]) {
       const auto v = s.value<std::string>();

@@ -17,6 +17,7 @@
 //   fracture = "off"                               # cohesive fracture: "off", "auto" or "on"
 //   scene_refinements = { potato_rect_cut = [-3, -2, -1] }   # a scene's own levels (optional)
 //   scene_degree = { clay_pull = 2 }               # a scene's own element degree (optional)
+//   scene_samples = { potato_rect_cut = 48 }       # a scene's own sample count (optional)
 //
 //   [models.springs]                               # optional: a model at several resolutions,
 //   resolutions = [4, 8, 12]                       # one row "springs [N = 4]" … each (instead of the
@@ -36,7 +37,7 @@
 //                                                  # holds shorter (study_runner.hpp)
 //   max_evaluations = 30                           # model runs of the fit (default 40)
 //   samples = 6                                    # reference solves on the calibration trajectory
-//                                                  # (default: [reference] samples)
+//                                                  # (default: the scene's [reference] samples)
 //   # fitted to the finest reference on the calibration trajectory, then run and scored, as
 //   # "MODEL (calibrated)", on the scene's own trajectory: held out from the fit.
 //
@@ -69,9 +70,9 @@ struct StudyReferenceSpec {
     const auto it = scene_degree.find(scene);
     return it == scene_degree.end() ? degree : it->second;
   }
-  /// Mesh levels, ascending; the last is the finest. Level k >= 0: the scene's mesh refined k
-  /// times (element size h/2^k); k < 0: the scene meshed anew at 2^-k h (reference_cache.hpp,
-  /// study_reference_scene), a cheap coarse level. In minimum_study_mesh_level..4.
+  /// Mesh levels, ascending; the last is the finest. Level k: the scene meshed anew at element
+  /// size 2^-k h, its graded sizes scaled alike (a .msh scene: refined k >= 0 times;
+  /// reference_cache.hpp, study_reference_scene). In minimum_study_mesh_level..4.
   std::vector<int> refinements{0};
   /// Per-scene mesh levels replacing `refinements` for the scenes named ([reference]
   /// scene_refinements = { NAME = [levels] }): a scene whose finest level costs more than a study
@@ -83,6 +84,15 @@ struct StudyReferenceSpec {
     return it == scene_refinements.end() ? refinements : it->second;
   }
   int samples = 40; ///< equilibrium solves along each trajectory (evenly spaced samples)
+  /// Per-scene sample counts replacing `samples` for the scenes named ([reference] scene_samples =
+  /// { NAME = N }): a scene whose force has finer structure (a cut's crack front advancing element
+  /// by element) needs more samples for its RMS over the trajectory to converge with the mesh.
+  std::map<std::string, int> scene_samples;
+  /// The sample count of the scene named `scene`: its own, else `samples`.
+  int samples_of(const std::string& scene) const {
+    const auto it = scene_samples.find(scene);
+    return it == scene_samples.end() ? samples : it->second;
+  }
   /// Linear solver of each Newton step (reference/finite_strain_solver.hpp): "auto" (direct below
   /// 60 000 DOFs, and above while the Cholesky factor stays small), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
   reference::LinearSolverChoice linear_solver = reference::LinearSolverChoice::automatic;

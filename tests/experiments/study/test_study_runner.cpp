@@ -37,7 +37,8 @@ TEST(StudySpec, ReadsScenesModelsAndReference) {
   const StudySpec s = read_study(write_study("ok.toml", "[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\n"
                                                         "models = [\"fracture\"]\n[reference]\ndegree = 2\n"
                                                         "refinements = [0, 1, 2]\nsamples = 12\n"
-                                                        "scene_degree = { potato_rect_cut = 1 }\n"));
+                                                        "scene_degree = { potato_rect_cut = 1 }\n"
+                                                        "scene_samples = { potato_rect_cut = 48 }\n"));
   EXPECT_EQ(s.name, "t");
   ASSERT_EQ(s.scenes.size(), 1u);
   EXPECT_EQ(s.scenes[0].filename(), "potato_rect_cut.toml");
@@ -47,6 +48,8 @@ TEST(StudySpec, ReadsScenesModelsAndReference) {
   EXPECT_EQ(s.reference.degree_of("clay_pull"), 2);       // the study's
   EXPECT_EQ(s.reference.refinements, (std::vector<int>{0, 1, 2}));
   EXPECT_EQ(s.reference.samples, 12);
+  EXPECT_EQ(s.reference.samples_of("potato_rect_cut"), 48); // its own count
+  EXPECT_EQ(s.reference.samples_of("clay_pull"), 12);       // the study's
 }
 
 TEST(StudySpec, ErrorsNameFileLineColumnAndKey) {
@@ -72,6 +75,12 @@ TEST(StudySpec, ErrorsNameFileLineColumnAndKey) {
       {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
        "scene_degree = { clay_pull = 2 }\n",
        ":6:30: reference.scene_degree.clay_pull"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
+       "scene_samples = { potato_rect_cut = 1 }\n",
+       ":6:37: reference.scene_samples.potato_rect_cut"},
+      {"[study]\nname = \"t\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n[reference]\n"
+       "scene_samples = { clay_pull = 48 }\n",
+       ":6:31: reference.scene_samples.clay_pull"},
   };
   int k = 0;
   for (const auto& [text, expected] : cases) {
