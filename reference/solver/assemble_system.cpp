@@ -8,6 +8,7 @@
 // contact and foundation forces).
 
 #include "reference/solver/finite_strain_impl.hpp"
+#include "reference/solver/cell_tangent.hpp"
 
 #include "reference/material/finite_strain_error.hpp"
 
@@ -104,7 +105,10 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
   std::vector<unsigned> comp(n);
   for (unsigned i = 0; i < n; ++i) comp[i] = fe->system_to_component_index(i).first;
   std::vector<Eigen::Vector3d> gradN(n);
-  std::vector<Eigen::Matrix<double, 9, 1>> AgradN(n);
+  CellTangentBlocks tangent;
+  const std::vector<unsigned>& node = geo.node_of_dof; // DOF i is component comp[i] of node node[i]
+  if (geo.nodes != 4 && geo.nodes != 10)
+    throw FiniteStrainError("finite strain: " + std::to_string(geo.nodes) + " nodes per cell, expected 4 or 10 (linear or quadratic tetrahedra)");
   std::vector<double> velocity(n);
 
   for (const auto& cell : dof.active_cell_iterators()) {
@@ -113,6 +117,7 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
     const std::size_t c_index = cell->active_cell_index();
     for (unsigned i = 0; i < n; ++i) cell_u[i] = state(local[i]);
     cell_K = 0.0;
+    if (with_matrix) tangent.set_zero();
     cell_int = 0.0;
     cell_ext = 0.0;
     const HyperelasticLaw& law = *laws[cell->material_id()];
@@ -163,17 +168,19 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
       // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
       for (unsigned i = 0; i < n; ++i) cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
       if (!with_matrix) continue;
-      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV; 𝔸 of a hyperelastic law has the
-      // major symmetry 𝔸_iJkL = 𝔸_kLiJ, so K is symmetric: its upper triangle here, the lower one
-      // mirrored below (the Kelvin–Voigt tangent has no such symmetry: then every entry).
-      for (unsigned j = 0; j < n; ++j) AgradN[j] = st.tangent.middleCols<3>(3 * comp[j]) * gradN[j];
-      for (unsigned i = 0; i < n; ++i)
-        for (unsigned j = damped ? 0 : i; j < n; ++j)
-          cell_K(i, j) += gradN[i].dot(AgradN[j].segment<3>(3 * comp[i])) * JxW;
+      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV, by blocks of component pairs
+      // (cell_tangent.hpp); 𝔸 of a hyperelastic law has the major symmetry 𝔸_iJkL = 𝔸_kLiJ, so K
+      // is symmetric and half its blocks are mirrored (the Kelvin–Voigt tangent has no such
+      // symmetry: then every block).
+      const double* G = geo.gradient(c_index, q, 0);
+      if (geo.nodes == 4) tangent.add<4>(G, st.tangent, JxW, !damped);
+      else tangent.add<10>(G, st.tangent, JxW, !damped);
     }
-    if (with_matrix && !damped)
+    if (with_matrix) {
+      if (!damped) tangent.complete_lower(static_cast<int>(geo.nodes));
       for (unsigned i = 0; i < n; ++i)
-        for (unsigned j = 0; j < i; ++j) cell_K(i, j) = cell_K(j, i);
+        for (unsigned j = 0; j < n; ++j) cell_K(i, j) += tangent(comp[i], comp[j])(node[i], node[j]);
+    }
 
     // Tractions and contact on boundary faces.
     for (const unsigned f : cell->face_indices()) {
