@@ -39,10 +39,13 @@ struct CalibrateOptions {
   bool fixed_exponents = false;
 };
 
-/// The reference on `scene` at level `refine`, `samples` solves, cached in `dir` under the key of
-/// the scene, its trajectory and the solver settings (reference_cache.hpp), written as dir/key.txt.
-ForceProfile reference_profile(const Scene& scene, int refine, int samples, const std::filesystem::path& dir) {
+/// The reference on `scene` at mesh level `refine` (a study's level: the scene meshed anew at
+/// 2^-refine times its element size, study_reference_scene), `samples` solves, cached in `dir` under
+/// the key of the scene, its trajectory and the solver settings (reference_cache.hpp), written as
+/// dir/key.txt.
+ForceProfile reference_profile(const Scene& scene_file, int refine, int samples, const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
+  const Scene scene = study_reference_scene(scene_file, refine);
   StudyReferenceSpec spec;
   spec.refinements = {refine};
   spec.samples = samples;
@@ -160,7 +163,7 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--target", options->target, "fit this force profile (CSV, docs/force-profile.md) instead of the reference");
   cmd->add_option("--validate", options->validate, "held-out haptic sessions, scored against the reference (besides the scene's trajectory at half and double speed)");
   cmd->add_option("--samples", options->samples, "reference equilibrium solves per trajectory (default 12)")->check(CLI::Range(2, 100000));
-  cmd->add_option("--refine", options->refine, "reference mesh refinement level (default 0)")->check(CLI::Range(0, 4));
+  cmd->add_option("--refine", options->refine, "reference mesh level K: the scene meshed at 2^-K times its element size, as a study's level (default 0)")->check(CLI::Range(0, 4));
   cmd->add_option("--max-evaluations", options->max_evaluations, "model runs per simplex search (default 150)")->check(CLI::Range(1, 100000));
   cmd->add_flag("--fixed-exponents", options->fixed_exponents, "fracture: keep the scene's exponents i, j (default: try all nine pairs)");
   cmd->add_option("-o,--output", options->out, "parameter file to write (default WORK/parameters.toml)");

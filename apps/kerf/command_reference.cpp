@@ -43,7 +43,7 @@ constexpr int default_reference_samples = 40;
 struct ReferenceOptions {
   std::string scene;
   std::string out;
-  int degree = 1;
+  int degree = 0; ///< 0: the scene's element_degree
   int refine = 0;
   /// Trajectory samples solved: N evenly spaced (first and last included), or "all". The default
   /// is one a user can wait for on a scene's mesh (a few minutes on two cores), fine enough to
@@ -75,8 +75,8 @@ struct ReferenceOptions {
   const std::string program = std::filesystem::read_symlink("/proc/self/exe").string();
   std::vector<std::string> args{"mpirun", "-np", std::to_string(o.np)};
   if (static_cast<unsigned>(o.np) > std::thread::hardware_concurrency()) args.emplace_back("--oversubscribe");
-  args.insert(args.end(), {program, "reference", o.scene, "--degree", std::to_string(o.degree), "--refine",
-                           std::to_string(o.refine)});
+  args.insert(args.end(), {program, "reference", o.scene, "--refine", std::to_string(o.refine)});
+  if (o.degree > 0) args.insert(args.end(), {"--degree", std::to_string(o.degree)});
   args.insert(args.end(), {"--samples", o.samples});
   if (o.until >= 0.0) args.insert(args.end(), {"--until", std::to_string(o.until)});
   if (o.levels > 0) args.insert(args.end(), {"--levels", std::to_string(o.levels)});
@@ -127,7 +127,7 @@ void run_reference_command(const ReferenceOptions& o) {
     scene.geometry.grasp_element_size = size;
   }
   ReferenceRunSettings settings;
-  settings.degree = o.degree;
+  settings.degree = o.degree > 0 ? o.degree : scene.geometry.element_degree;
   settings.refinements = o.refine;
   settings.write_fields = !o.no_fields;
   settings.resume = o.resume;
@@ -184,7 +184,7 @@ void run_reference_command(const ReferenceOptions& o) {
   double peak = 0.0;
   for (const ProfileRow& r : profile.rows) peak = std::max(peak, r.force.norm());
   std::printf("%s / reference (P%d, %d refinements): %zu samples solved, peak |F| %.6g N, wall %.2f s\n",
-              scene.name.c_str(), o.degree, o.refine, profile.rows.size(), peak, wall);
+              scene.name.c_str(), settings.degree, o.refine, profile.rows.size(), peak, wall);
   std::printf("wrote %s, %s%s\n", (out / "profile.csv").c_str(), (out / "manifest.json").c_str(),
               settings.write_fields ? (", " + (out / "fields.pvd").string()).c_str() : "");
 }
@@ -195,7 +195,8 @@ void add_reference_command(CLI::App& app) {
   auto options = std::make_shared<ReferenceOptions>();
   auto* cmd = app.add_subcommand("reference", "finite-strain reference run on a scene: profile.csv, manifest.json, fields.pvd");
   cmd->add_option("scene", options->scene, "scene file or name")->required();
-  cmd->add_option("--degree", options->degree, "finite element degree")->check(CLI::IsMember({1, 2}));
+  cmd->add_option("--degree", options->degree, "finite element degree (default: the scene's element_degree, else 1)")
+      ->check(CLI::IsMember({1, 2}));
   cmd->add_option("--refine", options->refine, "global mesh refinements")->check(CLI::Range(0, 4));
   cmd->add_option("--samples", options->samples,
                   "solve N evenly spaced trajectory samples, first and last included, or \"all\" (default " +

@@ -27,6 +27,11 @@ struct SceneGeometry {
   std::filesystem::path source;               ///< absolute path of the .geo, .stl or .msh
   std::map<std::string, double> parameters;   ///< .geo parameters, SI
   double element_size = 0.0;                  ///< target tetrahedron size [m] > 0
+  /// The finite-element reference's element degree (FE_SimplexP: 1 linear, 2 quadratic
+  /// tetrahedra), a mesh choice like element_size: quadratic where linear tetrahedra lock (a nearly
+  /// incompressible body strongly stretched), linear where a cohesive crack path needs many small
+  /// elements. `kerf reference` and a study use it unless told otherwise.
+  int element_degree = 1;
   /// The element size the scene file gives [m] (0: as element_size). A run that meshes the scene at
   /// another element size (a study's mesh level, `--element-size`) scales every size the mesh is
   /// graded to (scene_mesh_parameters) by element_size / nominal_element_size, so that a level is

@@ -449,7 +449,7 @@ private:
   }
 
   SceneGeometry read_geometry(const TableRef& t) {
-    allow_only(t, {"geo", "stl", "msh", "stl_scale", "element_size", "parameters"});
+    allow_only(t, {"geo", "stl", "msh", "stl_scale", "element_size", "element_degree", "parameters"});
     SceneGeometry g;
     std::string_view source_key;
     for (std::string_view k : {"geo", "stl", "msh"}) {
@@ -491,6 +491,10 @@ private:
       check(g.element_size > 0.0, t, "element_size", "a length > 0");
     }
     g.nominal_element_size = g.element_size;
+    if (t.find("element_degree") != nullptr) {
+      g.element_degree = required_integer(t, "element_degree");
+      check(g.element_degree == 1 || g.element_degree == 2, t, "element_degree", "1 (linear tetrahedra) or 2 (quadratic)");
+    }
 
     if (const toml::node* n = t.find("parameters")) {
       if (g.kind != SceneGeometry::Kind::geo)

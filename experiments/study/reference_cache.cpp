@@ -18,7 +18,7 @@ namespace kerf {
 ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, const Scene& scene, int level,
                                               const std::vector<std::size_t>& sample_indices) {
   ReferenceRunSettings settings;
-  settings.degree = spec.degree_of(scene.file.stem().string());
+  settings.degree = spec.degree_of(scene.file.stem().string(), scene.geometry.element_degree);
   // Every level of a scene with a geometry is meshed anew (study_reference_scene); a ready .msh
   // can only be refined: level k >= 0 refines it k times.
   settings.refinements = scene.geometry.kind == SceneGeometry::Kind::msh ? std::max(level, 0) : 0;

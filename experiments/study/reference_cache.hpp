@@ -23,8 +23,9 @@
 namespace kerf {
 
 /// The settings a study's reference solve of `scene` at mesh level `level` runs with: `spec`'s
-/// degree for the scene (StudyReferenceSpec::degree_of its file's stem), linear solver and fracture mode, the solved `sample_indices`, no field files, the mesh refined
-/// max(level, 0) times (a level below 0 is a coarser mesh instead: study_reference_scene), and the
+/// degree for the scene (StudyReferenceSpec::degree_of its file's stem and its element_degree),
+/// linear solver and fracture mode, the solved `sample_indices`, no field files, no refinement (the
+/// level is the scene meshed anew: study_reference_scene; a .msh scene refined `level` times), and the
 /// mesh not distributed (each solve is one process's run, whatever the study's MPI ranks:
 /// study_runner.hpp).
 ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, const Scene& scene, int level,

@@ -542,7 +542,7 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
     if (finest) {
       const int finest_level = references.rbegin()->first;
       try {
-        verified.verification = verify_reference(levels, tool, spec.reference.degree_of(scene.file.stem().string()) + 1.0);
+        verified.verification = verify_reference(levels, tool, spec.reference.degree_of(scene.file.stem().string(), scene.geometry.element_degree) + 1.0);
         verified.note = verified.verification ? verified.verification->summary()
                                               : "no GCI available: " + std::to_string(levels.size()) +
                                                     " mesh level(s), solution verification needs 3 ([reference] refinements)";

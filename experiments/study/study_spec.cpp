@@ -86,7 +86,7 @@ StudySpec read_study(const std::filesystem::path& file) {
     if (auto d = (*ref)["degree"]) {
       const auto v = d.value<int64_t>();
       if (!v || (*v != 1 && *v != 2)) fail(file, d.node()->source(), "reference.degree", "expected 1 or 2");
-      spec.reference.degree = static_cast<int>(*v);
+      spec.reference.degree = static_cast<int>(*v); // else each scene's own
     }
     // An array of ascending mesh levels, the last the finest.
     auto read_levels = [&](const toml::node_view<const toml::node>& r, const std::string& key) {

@@ -8,7 +8,8 @@
 //   models = ["fracture", "springs", "edge", "voxel"]   # each runs on the scenes it can represent
 //
 //   [reference]                                    # optional: the finite-element ground truth
-//   degree = 1
+//   degree = 1                                     # every scene's element degree (default: each
+//                                                  # scene's own, [geometry] element_degree)
 //   refinements = [0, 1]                           # mesh levels, ascending; the last is the finest;
 //                                                  # level k: the scene meshed anew at 2^-k times
 //                                                  # its element size (a .msh scene: refined k times)
@@ -48,6 +49,7 @@
 
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -60,15 +62,17 @@ inline constexpr int minimum_study_mesh_level = -3;
 /// The finite-element reference of a study ([reference]): its discretisation and solver settings.
 /// Every one of them is in the reference cache's key (reference_cache.hpp).
 struct StudyReferenceSpec {
-  int degree = 1;                   ///< FE_SimplexP degree, 1 or 2
-  /// Per-scene degrees replacing `degree` for the scenes named ([reference] scene_degree =
-  /// { NAME = 2 }): a nearly incompressible scene converges with quadratic elements, where linear
-  /// ones lock, while another scene of the study keeps linear ones.
+  /// FE_SimplexP degree, 1 or 2, for every scene of the study; unset: each scene's own
+  /// ([geometry] element_degree, SceneGeometry::element_degree).
+  std::optional<int> degree;
+  /// Per-scene degrees replacing the others for the scenes named ([reference] scene_degree =
+  /// { NAME = 2 }).
   std::map<std::string, int> scene_degree;
-  /// The element degree of the scene named `scene`: its own, else `degree`.
-  int degree_of(const std::string& scene) const {
+  /// The element degree of the scene named `scene`, whose file gives `scene_element_degree`:
+  /// scene_degree's, else the study's `degree`, else the scene's own.
+  int degree_of(const std::string& scene, int scene_element_degree) const {
     const auto it = scene_degree.find(scene);
-    return it == scene_degree.end() ? degree : it->second;
+    return it != scene_degree.end() ? it->second : degree.value_or(scene_element_degree);
   }
   /// Mesh levels, ascending; the last is the finest. Level k: the scene meshed anew at element
   /// size 2^-k h, its graded sizes scaled alike (a .msh scene: refined k >= 0 times;

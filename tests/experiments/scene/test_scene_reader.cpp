@@ -394,6 +394,13 @@ TEST_F(SceneReaderTest, GeometryIsFoundBesideTheSceneFirst) {
   EXPECT_EQ(s.geometry.source, m_dir / "rect_prism.geo");
 }
 
+TEST_F(SceneReaderTest, TheElementDegreeIsTheScenesOrLinear) {
+  EXPECT_EQ(read_scene(write("s.toml", minimal())).geometry.element_degree, 1);
+  EXPECT_EQ(read_scene(write("s.toml", minimal("geo = \"rect_prism.geo\"\nelement_size = 0.002\nelement_degree = 2\n")))
+                .geometry.element_degree,
+            2);
+}
+
 TEST_F(SceneReaderTest, GeometryIsFoundOnKerfGeoPath) {
   const fs::path other = m_dir / "other";
   fs::create_directories(other);
@@ -493,6 +500,8 @@ TEST_F(SceneReaderTest, RangesAreChecked) {
       {"fracture_toughness = \"0.2 kJ/m^2\"", "fracture_toughness = 0", "material.fracture_toughness"},
       {"cohesive_strength = \"0.5 N/mm^2\"", "cohesive_strength = \"-1 Pa\"", "material.cohesive_strength"},
       {"element_size = 0.002", "element_size = \"0 mm\"", "geometry.element_size"},
+      {"element_size = 0.002", "element_size = 0.002\nelement_degree = 3", "geometry.element_degree"},
+      {"element_size = 0.002", "element_size = 0.002\nelement_degree = \"2\"", "geometry.element_degree"},
       {"wedge_angle = 0.26", "wedge_angle = \"0 deg\"", "tools[0].wedge_angle"},
       {"rate = 2000", "rate = \"-1 kHz\"", "tools[0].trajectory.rate"},
       {"thickness = \"100 um\"", "thickness = \"1 MPa\"", "tools[0].thickness"},

@@ -41,7 +41,14 @@ TEST(ReferenceCache, StudySettingsCarryTheSpecAndNeverDistribute) {
   // A scene's own degree ([reference] scene_degree) replaces the study's for that scene only.
   spec.scene_degree["clay_pull"] = 1;
   EXPECT_EQ(study_reference_settings(spec, clay_pull(), 3, {0}).degree, 1);
-  EXPECT_EQ(study_reference_settings(spec, read_scene(fs::path(KERF_SCENES_DIR) / "potato_rect_cut.toml"), 3, {0}).degree, 2);
+  const Scene potato = read_scene(fs::path(KERF_SCENES_DIR) / "potato_rect_cut.toml");
+  EXPECT_EQ(study_reference_settings(spec, potato, 3, {0}).degree, 2);
+  // Without a study-wide degree each scene keeps its own ([geometry] element_degree): clay_pull's
+  // file asks for quadratic tetrahedra, potato_rect_cut's gives none (linear).
+  StudyReferenceSpec own;
+  EXPECT_EQ(clay_pull().geometry.element_degree, 2);
+  EXPECT_EQ(study_reference_settings(own, clay_pull(), 0, {0}).degree, 2);
+  EXPECT_EQ(study_reference_settings(own, potato, 0, {0}).degree, 1);
   EXPECT_EQ(s.refinements, 0); // level 3 is the geometry meshed anew (study_reference_scene), not refined
   EXPECT_EQ(s.sample_indices, (std::vector<std::size_t>{0, 5, 9}));
   EXPECT_EQ(s.linear_solver, reference::LinearSolverChoice::iterative);

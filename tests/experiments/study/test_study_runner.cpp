@@ -44,8 +44,9 @@ TEST(StudySpec, ReadsScenesModelsAndReference) {
   EXPECT_EQ(s.scenes[0].filename(), "potato_rect_cut.toml");
   EXPECT_TRUE(s.has_reference);
   EXPECT_EQ(s.reference.degree, 2);
-  EXPECT_EQ(s.reference.degree_of("potato_rect_cut"), 1); // its own degree
-  EXPECT_EQ(s.reference.degree_of("clay_pull"), 2);       // the study's
+  EXPECT_EQ(s.reference.degree_of("potato_rect_cut", 2), 1); // its own degree in the study
+  EXPECT_EQ(s.reference.degree_of("clay_pull", 1), 2);       // the study's, over the scene file's
+  EXPECT_EQ(StudyReferenceSpec{}.degree_of("clay_pull", 2), 2); // no degree in the study: the scene file's
   EXPECT_EQ(s.reference.refinements, (std::vector<int>{0, 1, 2}));
   EXPECT_EQ(s.reference.samples, 12);
   EXPECT_EQ(s.reference.samples_of("potato_rect_cut"), 48); // its own count
@@ -681,7 +682,7 @@ TEST(StudyRunner, TheCalibrationTrajectoryIsTheSamePathPlayedFaster) {
 TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
   // The study reports calibrated and uncalibrated rows side by side: the default study
   // fits every model `kerf calibrate` supports that runs on its scenes: the springs on clay_pull
-  // and the fracture model on potato_rect_cut (voxel runs on neither scene).
+  // and the fracture model on both potato cuts (voxel runs on none of the three scenes).
   const StudySpec s = read_study(fs::path(KERF_STUDIES_DIR) / "default.toml");
   ASSERT_TRUE(s.has_reference);
   std::set<std::pair<std::string, std::string>> fits;
@@ -689,11 +690,15 @@ TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
     fits.emplace(f.scene, f.model);
     EXPECT_NE(f.speed, 1.0); // the scene's own trajectory stays held out
   }
-  EXPECT_EQ(fits, (std::set<std::pair<std::string, std::string>>{{"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}}));
-  // Solution verification: three mesh levels for every scene (Reference III), the finest the
-  // scene's own mesh, the potato's levels its own ([reference] scene_refinements).
+  EXPECT_EQ(fits, (std::set<std::pair<std::string, std::string>>{
+                      {"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}, {"potato_wedge_cut", "fracture"}}));
+  // Solution verification: three mesh levels for every scene (Reference III): clay_pull's finest
+  // the scene's own mesh, the potato cuts' finest a crack path of 0.25 mm, half their own
+  // ([reference] scene_refinements), the rectangular cut on more samples ([reference] scene_samples).
   EXPECT_EQ(s.reference.levels_of("clay_pull"), (std::vector<int>{-2, -1, 0}));
-  EXPECT_EQ(s.reference.levels_of("potato_rect_cut"), (std::vector<int>{-2, -1, 0}));
+  EXPECT_EQ(s.reference.levels_of("potato_rect_cut"), (std::vector<int>{-1, 0, 1}));
+  EXPECT_EQ(s.reference.levels_of("potato_wedge_cut"), (std::vector<int>{-1, 0, 1}));
+  EXPECT_GT(s.reference.samples_of("potato_rect_cut"), s.reference.samples);
   // The shipped references, beside the study files.
   EXPECT_EQ(s.reference.library, (fs::path(KERF_STUDIES_DIR) / ".." / "references").lexically_normal());
 }
