@@ -2,7 +2,7 @@
 // How long the cohesive zone is, and whether a mesh resolves it — and which interaction mode of
 // paper 001 §4.2 a reference sample is in, read from the mechanics of the cohesive interface.
 
-#include "realtime/force_sample.hpp"
+#include "meshes/interaction_mode.hpp"
 
 namespace kerf::reference {
 

@@ -1,4 +1,4 @@
-#include "realtime/force_sample.hpp"
+#include "meshes/interaction_mode.hpp"
 
 #include <array>
 #include <utility>
