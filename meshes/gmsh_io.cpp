@@ -1,4 +1,5 @@
 #include "meshes/gmsh_io.hpp"
+#include "meshes/c_random_generator.hpp"
 
 #include "meshes/atomic_file.hpp"
 #include "meshes/mesh_error.hpp"
@@ -65,7 +66,8 @@ void ensure_gmsh_initialized() {
 /// naming the file.
 class GmshSession {
 public:
-  explicit GmshSession(std::string file) : m_lock(gmsh_mutex()), m_file(std::move(file)) {
+  explicit GmshSession(std::string file)
+      : m_lock(gmsh_mutex()), m_random_lock(c_random_generator_mutex()), m_file(std::move(file)) {
     ensure_gmsh_initialized();
     reset();
     gmsh::logger::start();
@@ -116,6 +118,7 @@ public:
 
 private:
   std::lock_guard<std::mutex> m_lock;
+  std::lock_guard<std::mutex> m_random_lock; // gmsh seeds and draws from the C library's rand()
   std::string m_file;
 };
 

@@ -1,4 +1,5 @@
 #include "reference/sparse_direct.hpp"
+#include "meshes/c_random_generator.hpp"
 
 #include <cholmod.h>
 #include <dlfcn.h>
@@ -190,7 +191,12 @@ void SparseDirect::analyze_cholesky() {
     std::copy(col_start.begin(), col_start.end(), static_cast<SuiteSparse_long*>(c.A->p));
     std::copy(row_index.begin(), row_index.end(), static_cast<SuiteSparse_long*>(c.A->i));
     const SerialOpenMP serial;
-    c.L = cholmod_l_analyze(c.A, &c.common);
+    {
+      // METIS, among the orderings the analysis tries, seeds and draws from the C library's
+      // rand(), which gmsh uses too (meshes/c_random_generator.hpp).
+      const std::lock_guard<std::mutex> random(c_random_generator_mutex());
+      c.L = cholmod_l_analyze(c.A, &c.common);
+    }
     if (c.L == nullptr || c.common.status < CHOLMOD_OK)
       throw std::runtime_error("SparseDirect: CHOLMOD's analysis failed (status " + std::to_string(c.common.status) + ")");
     m_counters.analysis_seconds += seconds_since(t0);
