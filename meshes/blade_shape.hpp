@@ -19,8 +19,9 @@ namespace kerf {
 ///   flanks, symmetric about the plane of e and d: with m = e × d the flanks are the planes
 ///   through the edge with normals sin(θ/2) d ± cos(θ/2) m; the wedge is closed by a slab of
 ///   `thickness` t (|(x − c)·m| <= t/2) behind the point where the flanks are t apart,
-///   t / (2 tan(θ/2)) behind the edge. A model that treats the edge only (a line, no wedge) reads
-///   e, d and L and ignores θ and t.
+///   t / (2 tan(θ/2)) behind the edge; it is bounded along e by the edge's ends. The reference's
+///   rigid tool is this wedge (reference/rigid_tool.hpp); the realtime models press the edge as a
+///   line (e, d, L).
 struct BladeShape {
   Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();     ///< e: unit, along the edge
   Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ(); ///< d: unit, orthogonal to e; the edge advances along it
