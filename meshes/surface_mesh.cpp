@@ -2,6 +2,7 @@
 
 #include "meshes/mesh_error.hpp"
 #include "meshes/tet_mesh.hpp"
+#include "meshes/triangle_closest_point.hpp"
 
 #include <algorithm>
 #include <array>
@@ -14,68 +15,6 @@
 namespace kerf {
 
 namespace {
-
-/// Which feature of a triangle (a, b, c) holds the closest point: a vertex, the edge opposite a
-/// local vertex, or the interior.
-enum class TriangleFeature { vertex_a, vertex_b, vertex_c, edge_bc, edge_ca, edge_ab, face };
-
-/// Closest point on triangle (a, b, c) to p, by the Voronoi-region tests of Ericson,
-/// "Real-Time Collision Detection" (2005), section 5.1.5 (ClosestPtPointTriangle): barycentric
-/// coordinates from the dot products d1..d6 decide the region without any division until the
-/// region is known. Degenerate triangles fall into a vertex or edge region (no NaN).
-Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                          const Eigen::Vector3d& c, TriangleFeature& feature) {
-  const Eigen::Vector3d ab = b - a;
-  const Eigen::Vector3d ac = c - a;
-  const Eigen::Vector3d ap = p - a;
-  const double d1 = ab.dot(ap);
-  const double d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) {
-    feature = TriangleFeature::vertex_a;
-    return a;
-  }
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp);
-  const double d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) {
-    feature = TriangleFeature::vertex_b;
-    return b;
-  }
-  // Edge region AB: vc = d1 d4 - d3 d2 <= 0, projection parameter v = d1 / (d1 - d3).
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    feature = TriangleFeature::edge_ab;
-    return a + (d1 / (d1 - d3)) * ab;
-  }
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp);
-  const double d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) {
-    feature = TriangleFeature::vertex_c;
-    return c;
-  }
-  // Edge region AC: vb = d5 d2 - d1 d6 <= 0, w = d2 / (d2 - d6).
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    feature = TriangleFeature::edge_ca;
-    return a + (d2 / (d2 - d6)) * ac;
-  }
-  // Edge region BC: va = d3 d6 - d5 d4 <= 0, w = (d4 - d3) / ((d4 - d3) + (d5 - d6)).
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    feature = TriangleFeature::edge_bc;
-    return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
-  }
-  // Interior: barycentric (u, v, w) = (va, vb, vc) / (va + vb + vc).
-  const double denominator = va + vb + vc;
-  if (!(denominator > 0.0)) {
-    // Only reachable for a numerically flat triangle: fall back to the nearest vertex.
-    feature = TriangleFeature::vertex_a;
-    return a;
-  }
-  feature = TriangleFeature::face;
-  return a + ab * (vb / denominator) + ac * (vc / denominator);
-}
 
 /// Squared distance from p to an axis-aligned box (0 inside): the lower bound for best-first search.
 double squared_distance_to_box(const Eigen::Vector3d& p, const Eigen::AlignedBox3d& box) {
@@ -217,13 +156,12 @@ SurfaceQuery::Closest SurfaceQuery::closest_point(const Eigen::Vector3d& p) cons
   m_tree.for_each_nearest(
       std::numeric_limits<double>::infinity(), [&](const Eigen::AlignedBox3d& box) { return squared_distance_to_box(p, box); },
       [&](std::int32_t f) {
-        TriangleFeature feature = TriangleFeature::face;
-        const Eigen::Vector3d q = closest_point_on_triangle(p, row3(V, F(f, 0)), row3(V, F(f, 1)), row3(V, F(f, 2)), feature);
-        const double squared = (p - q).squaredNorm();
+        const TriangleClosestPoint q = closest_point_on_triangle(p, row3(V, F(f, 0)), row3(V, F(f, 1)), row3(V, F(f, 2)));
+        const double squared = (p - q.point).squaredNorm();
         if (squared < best_squared) {
           best_squared = squared;
-          best_feature = feature;
-          result.point = q;
+          best_feature = q.feature;
+          result.point = q.point;
           result.triangle = f;
         }
         return squared;

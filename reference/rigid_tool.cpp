@@ -17,16 +17,16 @@ void validate(const RigidToolShape& s) {
       throw std::invalid_argument("rigid tool: sphere radius must be positive, got " + std::to_string(s.radius));
     return;
   }
-  if (std::abs(s.edge_direction.norm() - 1.0) > 1e-9 || std::abs(s.cutting_direction.norm() - 1.0) > 1e-9)
+  if (std::abs(s.blade.edge_direction.norm() - 1.0) > 1e-9 || std::abs(s.blade.cutting_direction.norm() - 1.0) > 1e-9)
     throw std::invalid_argument("rigid tool: wedge edge_direction and cutting_direction must be unit vectors");
-  if (std::abs(s.edge_direction.dot(s.cutting_direction)) > 1e-9)
+  if (std::abs(s.blade.edge_direction.dot(s.blade.cutting_direction)) > 1e-9)
     throw std::invalid_argument("rigid tool: wedge cutting_direction must be orthogonal to edge_direction");
-  if (!(s.wedge_angle > 0.0 && s.wedge_angle < std::numbers::pi))
-    throw std::invalid_argument("rigid tool: wedge_angle must lie in (0, pi), got " + std::to_string(s.wedge_angle));
-  if (!(s.thickness > 0.0) || !std::isfinite(s.thickness))
-    throw std::invalid_argument("rigid tool: wedge thickness must be positive, got " + std::to_string(s.thickness));
-  if (!(s.edge_length > 0.0) || !std::isfinite(s.edge_length))
-    throw std::invalid_argument("rigid tool: wedge edge_length must be positive, got " + std::to_string(s.edge_length));
+  if (!(s.blade.wedge_angle > 0.0 && s.blade.wedge_angle < std::numbers::pi))
+    throw std::invalid_argument("rigid tool: wedge_angle must lie in (0, pi), got " + std::to_string(s.blade.wedge_angle));
+  if (!(s.blade.thickness > 0.0) || !std::isfinite(s.blade.thickness))
+    throw std::invalid_argument("rigid tool: wedge thickness must be positive, got " + std::to_string(s.blade.thickness));
+  if (!(s.blade.edge_length > 0.0) || !std::isfinite(s.blade.edge_length))
+    throw std::invalid_argument("rigid tool: wedge edge_length must be positive, got " + std::to_string(s.blade.edge_length));
 }
 
 ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c, const Eigen::Vector3d& x,
@@ -45,15 +45,15 @@ ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c,
     out.normal_derivative = (Eigen::Matrix3d::Identity() - out.normal * out.normal.transpose()) / dist;
     return out;
   }
-  const Eigen::Vector3d& d = s.cutting_direction;
-  const Eigen::Vector3d m = s.edge_direction.cross(d);
-  const double phi = 0.5 * s.wedge_angle;
-  const Eigen::Vector3d& e = s.edge_direction;
+  const Eigen::Vector3d& d = s.blade.cutting_direction;
+  const Eigen::Vector3d m = s.blade.edge_direction.cross(d);
+  const double phi = 0.5 * s.blade.wedge_angle;
+  const Eigen::Vector3d& e = s.blade.edge_direction;
   const std::array<Eigen::Vector3d, 6> normals{std::sin(phi) * d + std::cos(phi) * m,
                                                std::sin(phi) * d - std::cos(phi) * m, m, -m, e, -e};
   // An edge_length of 0 (a shape that skipped validate) leaves the wedge unbounded along e.
-  const double half_length = s.edge_length > 0.0 ? 0.5 * s.edge_length : std::numeric_limits<double>::infinity();
-  const std::array<double, 6> offsets{0.0, 0.0, 0.5 * s.thickness, 0.5 * s.thickness, half_length, half_length};
+  const double half_length = s.blade.edge_length > 0.0 ? 0.5 * s.blade.edge_length : std::numeric_limits<double>::infinity();
+  const std::array<double, 6> offsets{0.0, 0.0, 0.5 * s.blade.thickness, 0.5 * s.blade.thickness, half_length, half_length};
   // Inside iff every s_k < 0 (whatever the side); the exit is the allowed face with the largest s_k.
   int face = -1;
   double largest = -std::numeric_limits<double>::infinity(), largest_any = largest;

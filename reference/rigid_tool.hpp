@@ -5,6 +5,8 @@
 // x inside the tool has penetration p = −g > 0 and is pushed out along the tool's outward normal n
 // by the traction t = ε_N p n (per unit reference area).
 
+#include "meshes/blade_shape.hpp"
+
 #include <Eigen/Core>
 
 namespace kerf::reference {
@@ -15,11 +17,9 @@ struct RigidToolShape {
   enum class Kind { sphere, wedge };
   Kind kind = Kind::sphere;
   double radius = 0.0; ///< sphere radius [m] > 0
-  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();     ///< wedge: unit edge direction e
-  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ(); ///< wedge: unit d ⟂ e, edge advances along d
-  double wedge_angle = 0.0; ///< wedge: included angle θ [rad] in (0, π)
-  double thickness = 0.0;   ///< wedge: back thickness t [m] > 0 (the slab behind the flanks)
-  double edge_length = 0.0; ///< wedge: edge length L [m] > 0, centred on the reference point
+  /// Wedge: the blade (meshes/blade_shape.hpp): edge direction e, cutting direction d ⟂ e, edge
+  /// length L centred on the reference point, included angle θ, back thickness t.
+  BladeShape blade;
 };
 
 /// Throws std::invalid_argument naming the field if the shape is not usable (non-positive size,

@@ -155,8 +155,9 @@ BodyView::BodyView(vtkRenderer* renderer, Colouring colouring, std::vector<ToolG
     auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
     if (g.blade) {
       // The edge and a flank behind it (half the edge length high), in tool-local coordinates.
-      const Eigen::Vector3d half = 0.5 * g.edge_length * g.edge_direction.normalized();
-      const Eigen::Vector3d back = -0.5 * g.edge_length * g.cutting_direction.normalized();
+      const BladeShape& shape = g.blade_shape;
+      const Eigen::Vector3d half = 0.5 * shape.edge_length * shape.edge_direction.normalized();
+      const Eigen::Vector3d back = -0.5 * shape.edge_length * shape.cutting_direction.normalized();
       Eigen::MatrixXd corners(4, 3);
       corners.row(0) = (-half).transpose();
       corners.row(1) = half.transpose();

@@ -3,6 +3,7 @@
 // Mises stress, the model's structure as a wire-frame overlay (toggled), the tool(s), the force
 // on each tool as an arrow, and a text block. The caller feeds it data; it owns the actors.
 
+#include "meshes/blade_shape.hpp"
 #include "viewer/body_geometry.hpp"
 
 #include <Eigen/Core>
@@ -36,14 +37,12 @@ std::string_view to_string(Colouring colouring);
 std::optional<Colouring> colouring_from_string(std::string_view name);
 
 /// A tool as drawn: a sphere of `radius` centred on the tool position, or a blade whose edge
-/// (length `edge_length` along `edge_direction`, centred on the tool position) leads a flank
-/// drawn behind it (against `cutting_direction`).
+/// (length `edge_length` along `edge_direction` of `blade_shape`, centred on the tool position)
+/// leads a flank drawn behind it (against its `cutting_direction`).
 struct ToolGlyph {
   bool blade = false;
-  double radius = 0.0;      ///< sphere [m]
-  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();
-  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ();
-  double edge_length = 0.0; ///< blade [m]
+  double radius = 0.0;    ///< sphere [m]
+  BladeShape blade_shape; ///< blade (meshes/blade_shape.hpp)
 };
 
 /// Elastic constants for colouring a BodyGeometry by von Mises stress (von_mises.hpp).

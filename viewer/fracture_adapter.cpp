@@ -31,8 +31,8 @@ void FractureAdapter::geometry(const ViewFrame& frame, BodyGeometry& out) {
     // The crack of paper 001 Fig. 3: from the entry point along the cutting axis to depth c,
     // across the edge length (centred on the edge midpoint, the tool's reference point).
     const Eigen::Vector3d o(frame.model.scalars[0], frame.model.scalars[1], frame.model.scalars[2]);
-    const Eigen::Vector3d half = 0.5 * s.edge_length * s.edge_direction;
-    const Eigen::Vector3d depth = c * s.cutting_direction;
+    const Eigen::Vector3d half = 0.5 * s.blade.edge_length * s.blade.edge_direction;
+    const Eigen::Vector3d depth = c * s.blade.cutting_direction;
     out.overlay_points.resize(4, 3);
     out.overlay_points.row(0) = (o - half).transpose();
     out.overlay_points.row(1) = (o + half).transpose();

@@ -114,8 +114,7 @@ void replay_runs(const ReplaySettings& settings) {
     const Scene& scene = replay.runs[i]->scene();
     std::vector<ToolGlyph> glyphs;
     for (const Tool& t : scene.tools)
-      glyphs.push_back({t.kind == Tool::Kind::blade, t.radius, t.blade.edge_direction, t.blade.cutting_direction,
-                        t.blade.edge_length});
+      glyphs.push_back({t.kind == Tool::Kind::blade, t.radius, t.blade});
     replay.views.push_back(std::make_unique<BodyView>(window.body_renderer(static_cast<int>(i)), settings.colouring, glyphs));
     replay.views.back()->set_overlay_visible(settings.overlay);
     replay.views.back()->set_legend_visible(settings.text);

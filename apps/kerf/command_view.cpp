@@ -85,9 +85,7 @@ std::vector<ToolGlyph> tool_glyphs(const Scene& scene) {
     ToolGlyph g;
     g.blade = t.kind == Tool::Kind::blade;
     g.radius = t.radius;
-    g.edge_direction = t.blade.edge_direction;
-    g.cutting_direction = t.blade.cutting_direction;
-    g.edge_length = t.blade.edge_length;
+    g.blade_shape = t.blade;
     glyphs.push_back(g);
   }
   return glyphs;

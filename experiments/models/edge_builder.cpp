@@ -50,9 +50,7 @@ EdgeSceneSetup edge_setup_for_scene(const Scene& scene, const Tool& tool) {
   EdgeSceneSetup e;
   e.voxel_size = scene.geometry.element_size / 4.0;
   DiscreteEdgeSetup& setup = e.setup;
-  setup.edge_direction = blade.edge_direction;
-  setup.cutting_direction = blade.cutting_direction;
-  setup.edge_length = blade.edge_length;
+  setup.blade = blade;
   setup.point_count = std::max(1, static_cast<int>(std::ceil(blade.edge_length / e.voxel_size)));
   setup.friction_coefficient = scene.phenomena.contains(Phenomenon::friction) ? scene.material.friction_coefficient : 0.0;
   setup.channel_capture_width = std::max(blade.thickness, e.voxel_size);
@@ -67,9 +65,9 @@ EdgeSceneSetup edge_setup_for_scene(const Scene& scene, const Tool& tool) {
   }
 
   nlohmann::json& p = e.parameters;
-  p["edge_direction"] = vector_json(setup.edge_direction);
-  p["cutting_direction"] = vector_json(setup.cutting_direction);
-  p["edge_length_m"] = setup.edge_length;
+  p["edge_direction"] = vector_json(setup.blade.edge_direction);
+  p["cutting_direction"] = vector_json(setup.blade.cutting_direction);
+  p["edge_length_m"] = setup.blade.edge_length;
   p["point_count"] = setup.point_count;
   p["voxel_size_m"] = e.voxel_size;
   p["regions"] = e.regions;
@@ -94,9 +92,9 @@ BuiltModel build_edge_model(const Scene& scene, const TetMesh& mesh) {
   EdgeSceneSetup e = edge_setup_for_scene(scene, scene.tools.front());
   CollisionVoxels voxels(mesh, e.voxel_size, e.regions);
   e.parameters["marked_voxels"] = voxels.marked_count();
-  const RecordedEdge edge{e.setup.edge_direction, e.setup.edge_length};
+  const BladeShape blade = e.setup.blade;
   auto model = std::make_unique<DiscreteEdgeCuttingModel>(std::move(voxels), std::move(e.setup));
-  model->attach_geometric_cut(std::make_unique<BackgroundCut>(mesh, edge, e.cut), e.record_spacing);
+  model->attach_geometric_cut(std::make_unique<BackgroundCut>(mesh, blade, e.cut), e.record_spacing);
   BuiltModel built{std::move(model), std::move(e.parameters)};
   built.write_outputs = [edge_model = static_cast<DiscreteEdgeCuttingModel*>(built.model.get())](const std::filesystem::path& dir, VtuWriter write) {
     return write_geometric_cut(*edge_model, dir, write);

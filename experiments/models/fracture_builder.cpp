@@ -24,9 +24,7 @@ void require_fracture_inputs(const Scene& scene) {
 BuiltModel build_fracture_model(const Scene& scene, const TetMesh& mesh) {
   const BladeShape& blade = scene.tools.front().blade;
   FractureCuttingSetup setup;
-  setup.edge_direction = blade.edge_direction;
-  setup.cutting_direction = blade.cutting_direction;
-  setup.edge_length = blade.edge_length;
+  setup.blade = blade;
   setup.response = *scene.fracture;
   // Only the machinery the scene needs: per-layer lengths for a layered body, friction only if
   // the scene declares it.
@@ -38,9 +36,9 @@ BuiltModel build_fracture_model(const Scene& scene, const TetMesh& mesh) {
   setup.crack_capture_width = std::max(blade.thickness, 1e-6);
 
   nlohmann::json p;
-  p["edge_direction"] = vector_json(setup.edge_direction);
-  p["cutting_direction"] = vector_json(setup.cutting_direction);
-  p["edge_length_m"] = setup.edge_length;
+  p["edge_direction"] = vector_json(setup.blade.edge_direction);
+  p["cutting_direction"] = vector_json(setup.blade.cutting_direction);
+  p["edge_length_m"] = setup.blade.edge_length;
   p["regions"] = setup.regions;
   p["fracture_toughness_J_per_m2"] = setup.fracture_toughness;
   p["rupture_force_per_length_N_per_m"] = setup.response.rupture_force_per_length;

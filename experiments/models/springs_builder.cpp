@@ -206,7 +206,7 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
   for (const Support& s : scene.supports) setup.supports.push_back({s.surface, s.kind == Support::Kind::sliding});
   for (const Tool& t : scene.tools) {
     if (t.kind == Tool::Kind::blade) {
-      setup.styluses.push_back({t.trajectory.start, 0.0, SpringBladeEdge{t.blade.edge_direction, t.blade.cutting_direction, t.blade.edge_length}});
+      setup.styluses.push_back({t.trajectory.start, 0.0, t.blade});
       // A blade crushes the cells under its edge: backward Euler unless the scene or the
       // command line says otherwise (the explicit limit shrinks with the crushed springs).
       if (!settings.integrator && options.find("integrator") == options.end()) setup.integrator = SpringIntegrator::implicit_euler;

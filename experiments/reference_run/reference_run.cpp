@@ -165,11 +165,7 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh) {
                                     "styluses that grasp the surface (tied)");
       reference::RigidToolShape shape;
       shape.kind = reference::RigidToolShape::Kind::wedge;
-      shape.edge_direction = tool.blade.edge_direction;
-      shape.cutting_direction = tool.blade.cutting_direction;
-      shape.wedge_angle = tool.blade.wedge_angle;
-      shape.thickness = tool.blade.thickness;
-      shape.edge_length = tool.blade.edge_length;
+      shape.blade = tool.blade;
       p.tool = shape;
       continue;
     }

@@ -3,6 +3,7 @@
 // read from experiments/scenes/NAME.toml. All quantities are SI: the reader converts units once.
 
 #include "experiments/trajectory/trajectory.hpp"
+#include "meshes/blade_shape.hpp"
 #include "meshes/material_law.hpp"
 #include "realtime/fracture/fracture_response.hpp"
 #include "realtime/phenomena.hpp"
@@ -70,23 +71,12 @@ struct Support {
   Kind kind = Kind::bonded;
 };
 
-/// A blade: a straight edge of length `edge_length` through the tool's reference point along
-/// `edge_direction`, advancing along `cutting_direction`; a wedge of angle `wedge_angle` and back
-/// thickness `thickness` behind it.
-struct BladeShape {
-  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();    ///< unit
-  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ(); ///< unit, orthogonal to the edge
-  double edge_length = 0.0;  ///< [m] > 0
-  double wedge_angle = 0.0;  ///< [rad] in (0, pi)
-  double thickness = 0.0;    ///< [m] > 0
-};
-
 /// A tool: a blade, or a sphere/stylus tip of radius `radius`, and its trajectory.
 struct Tool {
   enum class Kind { blade, sphere };
   std::string name;
   Kind kind = Kind::blade;
-  BladeShape blade;           ///< blade only
+  BladeShape blade;           ///< blade only (meshes/blade_shape.hpp)
   double radius = 0.0;        ///< [m] > 0, sphere only
   /// Sphere only: the stylus grasps the surface (paper 000 §2.1: "pulling up"; §2.2: tearing) over
   /// the disc of this radius [m] > 0 centred under its tip at its start. The disc is a physical region

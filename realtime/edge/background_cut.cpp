@@ -13,12 +13,12 @@ constexpr auto poll_interval = std::chrono::milliseconds(1);
 
 } // namespace
 
-BackgroundCut::BackgroundCut(TetMesh mesh, RecordedEdge edge, GeometricCutOptions options, int capacity,
+BackgroundCut::BackgroundCut(TetMesh mesh, BladeShape blade, GeometricCutOptions options, int capacity,
                              AfterCut after_cut)
-    : m_original(std::move(mesh)), m_body(m_original), m_edge(edge), m_options(options),
+    : m_original(std::move(mesh)), m_body(m_original), m_blade(blade), m_options(options),
       m_after_cut(std::move(after_cut)) {
-  if (std::abs(m_edge.direction.norm() - 1.0) > 1e-9) throw std::invalid_argument("background cut: edge direction must be a unit vector");
-  if (!(m_edge.length > 0.0) || !std::isfinite(m_edge.length)) throw std::invalid_argument("background cut: edge length must be positive");
+  if (std::abs(m_blade.edge_direction.norm() - 1.0) > 1e-9) throw std::invalid_argument("background cut: edge direction must be a unit vector");
+  if (!(m_blade.edge_length > 0.0) || !std::isfinite(m_blade.edge_length)) throw std::invalid_argument("background cut: edge length must be positive");
   if (capacity < 2) throw std::invalid_argument("background cut: the buffer must hold at least two positions");
   m_buffer.assign(static_cast<std::size_t>(capacity), Eigen::Vector3d::Zero());
   m_worker = std::thread([this] { work(); });
@@ -63,7 +63,7 @@ void BackgroundCut::work() {
     m_state.store(0, std::memory_order_release);
     try {
       // Paper 000 §3.2: "the trajectory surface is defined as a set of triangular patches".
-      const SweptSurface surface = sweep_edge(pass, m_edge.direction, m_edge.length);
+      const SweptSurface surface = sweep_edge(pass, m_blade.edge_direction, m_blade.edge_length);
       const GeometricCutReport report = m_body.cut(surface, m_options);
       m_reports.push_back(report);
       if (m_after_cut) m_after_cut(m_body, report);

@@ -5,6 +5,7 @@
 // publishes the count of cuts applied with another atomic store. The servo side never allocates,
 // locks, waits or signals.
 
+#include "meshes/blade_shape.hpp"
 #include "realtime/edge/geometric_cut.hpp"
 
 #include <Eigen/Core>
@@ -16,13 +17,6 @@
 #include <vector>
 
 namespace kerf {
-
-/// The straight cutting edge whose trajectory is recorded: unit direction along the edge and its
-/// length L [m] (the swept strip's width, sweep_edge).
-struct RecordedEdge {
-  Eigen::Vector3d direction = Eigen::Vector3d::UnitY();
-  double length = 0.0;
-};
 
 /// Hand-over protocol (single producer, single consumer, on one atomic state word):
 /// - recording (state 0): the servo thread owns the buffer; `record` appends edge-centre
@@ -38,10 +32,11 @@ public:
   /// Called on the worker thread after each cut, with the body as cut and what the cut did.
   using AfterCut = std::function<void(const CuttableBody&, const GeometricCutReport&)>;
 
-  /// Takes the body's mesh (positively oriented tetrahedra), the edge, the cut's tolerances, the
-  /// buffer capacity in positions (>= 2) and an optional hook; starts the worker. Throws
-  /// std::invalid_argument on a bad edge or capacity.
-  BackgroundCut(TetMesh mesh, RecordedEdge edge, GeometricCutOptions options = {}, int capacity = 4096,
+  /// Takes the body's mesh (positively oriented tetrahedra), the blade whose edge's trajectory is
+  /// recorded (its edge_direction and edge_length L, the swept strip's width, sweep_edge; the
+  /// wedge is not used), the cut's tolerances, the buffer capacity in positions (>= 2) and an
+  /// optional hook; starts the worker. Throws std::invalid_argument on a bad edge or capacity.
+  BackgroundCut(TetMesh mesh, BladeShape blade, GeometricCutOptions options = {}, int capacity = 4096,
                 AfterCut after_cut = {});
   ~BackgroundCut();
   BackgroundCut(const BackgroundCut&) = delete;
@@ -81,7 +76,7 @@ private:
 
   const TetMesh m_original;
   CuttableBody m_body;
-  RecordedEdge m_edge;
+  BladeShape m_blade;
   GeometricCutOptions m_options;
   AfterCut m_after_cut;
   std::vector<Eigen::Vector3d> m_buffer; ///< sized once

@@ -19,9 +19,9 @@ bool finite_non_negative(double x) { return x >= 0.0 && std::isfinite(x); }
 
 DiscreteEdgeCuttingModel::DiscreteEdgeCuttingModel(CollisionVoxels voxels, DiscreteEdgeSetup setup)
     : m_voxels(std::move(voxels)), m_setup(std::move(setup)) {
-  require(std::abs(m_setup.edge_direction.norm() - 1.0) < 1e-9, "edge direction must be a unit vector");
-  require(std::abs(m_setup.cutting_direction.norm() - 1.0) < 1e-9, "cutting direction must be a unit vector");
-  require(m_setup.edge_length > 0.0 && std::isfinite(m_setup.edge_length), "edge length must be positive");
+  require(std::abs(m_setup.blade.edge_direction.norm() - 1.0) < 1e-9, "edge direction must be a unit vector");
+  require(std::abs(m_setup.blade.cutting_direction.norm() - 1.0) < 1e-9, "cutting direction must be a unit vector");
+  require(m_setup.blade.edge_length > 0.0 && std::isfinite(m_setup.blade.edge_length), "edge length must be positive");
   require(m_setup.point_count >= 1 && m_setup.point_count <= 100000, "point count K must be in [1, 100000]");
   require(!m_setup.materials.empty(), "at least one material is needed");
   for (const EdgeMaterial& m : m_setup.materials) {
@@ -31,7 +31,7 @@ DiscreteEdgeCuttingModel::DiscreteEdgeCuttingModel(CollisionVoxels voxels, Discr
   }
   require(finite_non_negative(m_setup.friction_coefficient), "friction coefficient must be >= 0");
   require(finite_non_negative(m_setup.channel_capture_width), "channel capture width must be >= 0");
-  m_piece_length = m_setup.edge_length / m_setup.point_count;
+  m_piece_length = m_setup.blade.edge_length / m_setup.point_count;
   m_points.assign(static_cast<std::size_t>(m_setup.point_count), Point{});
 }
 
@@ -116,7 +116,7 @@ void DiscreteEdgeCuttingModel::update_point(Point& point, const Eigen::Vector3d&
     // A new collision: the relaxed point is where the edge entered the undeformed object.
     const Eigen::Vector3d motion = have_previous ? Eigen::Vector3d(p - previous) : Eigen::Vector3d::Zero();
     const double length = motion.norm();
-    const Eigen::Vector3d n = length > 0.0 ? Eigen::Vector3d(motion / length) : m_setup.cutting_direction;
+    const Eigen::Vector3d n = length > 0.0 ? Eigen::Vector3d(motion / length) : m_setup.blade.cutting_direction;
     const Eigen::Vector3d surface = have_previous && !m_voxels.marked(previous) ? entry_point(previous, p) : p;
     bool in_channel = false;
     if (point.has_cut) { // back into the cut this point made: the material starts at its front
@@ -142,7 +142,7 @@ void DiscreteEdgeCuttingModel::update_point(Point& point, const Eigen::Vector3d&
   const double k = material.stiffness_per_length * m_piece_length;
   const double shear_limit = material.shear_limit_per_length * m_piece_length;
   const double b = material.drag_per_length * m_piece_length;
-  const Eigen::Vector3d& e = m_setup.edge_direction;
+  const Eigen::Vector3d& e = m_setup.blade.edge_direction;
 
   Eigen::Vector3d elastic = Eigen::Vector3d::Zero();
   const Eigen::Vector3d d = p - point.relaxed; // the deformation: disparity of present and relaxed points
@@ -193,12 +193,12 @@ void DiscreteEdgeCuttingModel::step(std::span<const ToolState> tools, double /*d
   bool any_contact = false;
   int cut_points = 0;
   Eigen::Vector3d entry = Eigen::Vector3d::Zero(), front = Eigen::Vector3d::Zero(), inward = Eigen::Vector3d::Zero();
-  const double half = 0.5 * m_setup.edge_length;
+  const double half = 0.5 * m_setup.blade.edge_length;
   for (std::size_t i = 0; i < m_points.size(); ++i) {
     // p_i = c + s_i e, s_i the midpoint of the i-th of K equal pieces.
     const double s = -half + (static_cast<double>(i) + 0.5) * m_piece_length;
     Point& point = m_points[i];
-    update_point(point, c + s * m_setup.edge_direction, v, m_have_previous);
+    update_point(point, c + s * m_setup.blade.edge_direction, v, m_have_previous);
     total += point.force;
     any_cutting = any_cutting || point.cutting;
     if (point.in_contact) {
@@ -209,8 +209,8 @@ void DiscreteEdgeCuttingModel::step(std::span<const ToolState> tools, double /*d
     any_contact = any_contact || point.in_contact;
     if (point.in_contact && point.has_cut) { // the crack front and its entry, referred to the edge's centre
       ++cut_points;
-      entry += point.entry - s * m_setup.edge_direction;
-      front += point.relaxed - s * m_setup.edge_direction;
+      entry += point.entry - s * m_setup.blade.edge_direction;
+      front += point.relaxed - s * m_setup.blade.edge_direction;
       inward += point.inward;
     }
   }

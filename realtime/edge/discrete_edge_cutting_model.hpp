@@ -3,6 +3,7 @@
 // Deforming Operations) on a blade edge discretised into K independent points, with collision
 // through the voxel model of §3.3.
 
+#include "meshes/blade_shape.hpp"
 #include "realtime/edge/background_cut.hpp"
 #include "realtime/edge/collision_voxels.hpp"
 #include "realtime/tool_model.hpp"
@@ -28,9 +29,10 @@ struct EdgeMaterial {
 
 /// The blade and body as the edge model sees them (SI units).
 struct DiscreteEdgeSetup {
-  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();     ///< unit, along the edge
-  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ(); ///< unit, used when the edge enters at rest
-  double edge_length = 0.0;                                      ///< L [m] > 0
+  /// The blade (meshes/blade_shape.hpp): its edge e = edge_direction, L = edge_length > 0, and
+  /// cutting_direction, the direction of entry of a point that enters at rest; the edge is a line,
+  /// its wedge (wedge_angle, thickness) is not used.
+  BladeShape blade;
   int point_count = 0;                                           ///< K >= 1 discrete edges
   std::vector<EdgeMaterial> materials; ///< one per region of the collision voxels (layers)
   /// Coulomb friction coefficient μ of the edge sliding along its own axis (non-destructive);

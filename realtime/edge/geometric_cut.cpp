@@ -1,5 +1,7 @@
 #include "realtime/edge/geometric_cut.hpp"
 
+#include "meshes/triangle_closest_point.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -130,7 +132,7 @@ GeometricCutReport CuttableBody::cut(const SweptSurface& surface, const Geometri
     double best = std::numeric_limits<double>::infinity();
     std::size_t which = 0;
     for (std::size_t f = 0; f < triangles.size(); ++f) {
-      const double d2 = (p - closest_point_on_triangle(p, triangles[f][0], triangles[f][1], triangles[f][2])).squaredNorm();
+      const double d2 = (p - closest_point_on_triangle(p, triangles[f][0], triangles[f][1], triangles[f][2]).point).squaredNorm();
       if (d2 < best) { best = d2; which = f; }
     }
     distance = std::sqrt(best);

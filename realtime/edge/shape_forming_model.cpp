@@ -1,5 +1,7 @@
 #include "realtime/edge/shape_forming_model.hpp"
 
+#include "meshes/triangle_closest_point.hpp"
+
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
@@ -59,7 +61,7 @@ TetMesh fragment_mesh(const CuttableBody& body, int fragment, std::vector<int>& 
         if (!boxes[static_cast<std::size_t>(f)].contains(p)) continue;
         const Eigen::Vector3d a = cut.nodes.row(g.triangles(f, 0)), b = cut.nodes.row(g.triangles(f, 1)),
                               c = cut.nodes.row(g.triangles(f, 2));
-        if ((closest_point_on_triangle(p, a, b, c) - p).norm() <= tolerance) return true;
+        if ((closest_point_on_triangle(p, a, b, c).point - p).norm() <= tolerance) return true;
       }
       return false;
     };
@@ -82,8 +84,8 @@ ShapeFormingModel::ShapeFormingModel(const TetMesh& mesh, ShapeFormingSetup setu
   if (!(m_setup.voxel_size > 0.0)) throw std::invalid_argument("shape forming: voxel size must be positive");
   m_edge = std::make_unique<DiscreteEdgeCuttingModel>(CollisionVoxels(mesh, m_setup.voxel_size, m_setup.regions), m_setup.edge);
   m_edge->attach_geometric_cut(
-      std::make_unique<BackgroundCut>(mesh, RecordedEdge{m_setup.edge.edge_direction, m_setup.edge.edge_length}, m_setup.cut,
-                                      4096, [this](const CuttableBody& body, const GeometricCutReport&) { build_stage(body); }),
+      std::make_unique<BackgroundCut>(mesh, m_setup.edge.blade, m_setup.cut, 4096,
+                                      [this](const CuttableBody& body, const GeometricCutReport&) { build_stage(body); }),
       m_setup.record_spacing);
 }
 

@@ -24,8 +24,4 @@ struct SweptSurface {
 SweptSurface sweep_edge(std::span<const Eigen::Vector3d> centres, const Eigen::Vector3d& edge_direction,
                         double edge_length);
 
-/// Closest point to `p` on the triangle (a, b, c) (Ericson, Real-Time Collision Detection, §5.1.5).
-Eigen::Vector3d closest_point_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                                          const Eigen::Vector3d& c);
-
 } // namespace kerf

@@ -27,11 +27,11 @@ constexpr double contact_threshold = 1e-12;
 FractureCuttingModel::FractureCuttingModel(const TetMesh& mesh, FractureCuttingSetup setup)
     : m_setup(std::move(setup)), m_length(mesh, m_setup.regions) {
   const FractureResponseParameters& r = m_setup.response;
-  require(std::abs(m_setup.edge_direction.norm() - 1.0) < 1e-9, "edge direction must be a unit vector");
-  require(std::abs(m_setup.cutting_direction.norm() - 1.0) < 1e-9, "cutting direction must be a unit vector");
-  require(std::abs(m_setup.edge_direction.dot(m_setup.cutting_direction)) < 1e-6,
+  require(std::abs(m_setup.blade.edge_direction.norm() - 1.0) < 1e-9, "edge direction must be a unit vector");
+  require(std::abs(m_setup.blade.cutting_direction.norm() - 1.0) < 1e-9, "cutting direction must be a unit vector");
+  require(std::abs(m_setup.blade.edge_direction.dot(m_setup.blade.cutting_direction)) < 1e-6,
           "cutting direction must be orthogonal to the edge");
-  require(m_setup.edge_length > 0.0 && std::isfinite(m_setup.edge_length), "edge length must be positive");
+  require(m_setup.blade.edge_length > 0.0 && std::isfinite(m_setup.blade.edge_length), "edge length must be positive");
   require(r.rupture_force_per_length > 0.0 && std::isfinite(r.rupture_force_per_length), "f_r must be positive");
   require(r.rupture_deflection > 0.0 && std::isfinite(r.rupture_deflection), "δ_r must be positive");
   require(r.crack_deflection > 0.0 && std::isfinite(r.crack_deflection), "δ_c must be positive");
@@ -43,7 +43,7 @@ FractureCuttingModel::FractureCuttingModel(const TetMesh& mesh, FractureCuttingS
           "one fracture toughness per region is needed");
   for (double jc : m_setup.fracture_toughness) require(jc > 0.0 && std::isfinite(jc), "J_c must be positive");
 
-  m_lateral_direction = m_setup.edge_direction.cross(m_setup.cutting_direction).normalized();
+  m_lateral_direction = m_setup.blade.edge_direction.cross(m_setup.blade.cutting_direction).normalized();
   m_lengths.assign(static_cast<std::size_t>(m_length.region_count()), 0.0);
   if (m_setup.friction) {
     require(m_setup.friction_coefficient >= 0.0, "friction coefficient must be >= 0");
@@ -74,12 +74,12 @@ double FractureCuttingModel::f2_over_toughness(double deflection) const {
 }
 
 double FractureCuttingModel::measure(const Eigen::Vector3d& p) {
-  const Eigen::Vector3d half = 0.5 * m_setup.edge_length * m_setup.edge_direction;
+  const Eigen::Vector3d half = 0.5 * m_setup.blade.edge_length * m_setup.blade.edge_direction;
   return m_length.lengths(p - half, p + half, m_lengths);
 }
 
 double FractureCuttingModel::entry_depth(const Eigen::Vector3d& p, double hint) {
-  const Eigen::Vector3d& e_x = m_setup.cutting_direction;
+  const Eigen::Vector3d& e_x = m_setup.blade.cutting_direction;
   // Bracket: at s = 0 the edge is in contact; find s_hi where it is not (doubling, bounded).
   double s_lo = 0.0;
   double s_hi = std::max(hint, 1e-6);
@@ -107,7 +107,7 @@ void FractureCuttingModel::step(std::span<const ToolState> tools, double /*dt*/,
     ++m_non_finite;
     return;
   }
-  const Eigen::Vector3d& e_x = m_setup.cutting_direction;
+  const Eigen::Vector3d& e_x = m_setup.blade.cutting_direction;
   const Eigen::Vector3d& e_y = m_lateral_direction;
   const Eigen::Vector3d motion = m_have_previous ? Eigen::Vector3d(p - m_previous_position) : Eigen::Vector3d::Zero();
   m_previous_position = p;

@@ -3,6 +3,7 @@
 // (Mahvash & Hayward, "Haptic Rendering of Cutting: A Fracture Mechanics Approach"), §4 and the
 // algorithm of its Fig. 11, with the contact length l(x) measured on the scene's mesh.
 
+#include "meshes/blade_shape.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "realtime/fracture/contact_length.hpp"
 #include "realtime/fracture/fracture_response.hpp"
@@ -19,9 +20,10 @@ namespace kerf {
 
 /// The blade and body as the fracture model sees them (SI units).
 struct FractureCuttingSetup {
-  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();     ///< unit, along the edge
-  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ(); ///< unit, the fixed cutting axis
-  double edge_length = 0.0;                                      ///< [m]
+  /// The blade (meshes/blade_shape.hpp): its edge (edge_direction, edge_length) and
+  /// cutting_direction, the fixed cutting axis e_x; paper 001's blade is sharp, its wedge
+  /// (wedge_angle, thickness) is not used.
+  BladeShape blade;
   /// Regions of a layered body (volume group names) and the toughness J_c of each [J/m^2];
   /// one unnamed region (the whole mesh) when `regions` is empty.
   std::vector<std::string> regions;

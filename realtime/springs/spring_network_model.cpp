@@ -142,8 +142,8 @@ SpringNetworkModel::SpringNetworkModel(const TetMesh& mesh, SpringNetworkSetup s
   for (const SpringStylus& t : s.styluses)
     if (t.blade) {
       if (s.styluses.size() != 1) throw std::invalid_argument("springs: a blade is taken alone (one tool)");
-      const SpringBladeEdge& b = *t.blade;
-      if (!(b.length > 0.0)) throw std::invalid_argument("springs: the blade's edge length must be > 0 m");
+      const BladeShape& b = *t.blade;
+      if (!(b.edge_length > 0.0)) throw std::invalid_argument("springs: the blade's edge length must be > 0 m");
       if (std::abs(b.edge_direction.norm() - 1.0) > 1e-9 || std::abs(b.cutting_direction.norm() - 1.0) > 1e-9 ||
           std::abs(b.edge_direction.dot(b.cutting_direction)) > 1e-9)
         throw std::invalid_argument("springs: the blade's edge and cutting directions must be orthogonal unit vectors");
@@ -180,7 +180,7 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
   // A blade's reach: its edge's span within the body's box.
   double reach = 2.0 * spread;
   for (const SpringStylus& t : s.styluses)
-    if (t.blade) reach = std::max(reach, std::min(t.blade->length, extent.dot(t.blade->edge_direction.cwiseAbs())));
+    if (t.blade) reach = std::max(reach, std::min(t.blade->edge_length, extent.dot(t.blade->edge_direction.cwiseAbs())));
   const double h = s.cell_size > 0.0 ? s.cell_size : std::max(extent.minCoeff(), reach) / s.cells;
   const double side = h * s.cells;
   NetworkBlock block;
@@ -255,7 +255,7 @@ void SpringNetworkModel::build(const TetMesh& mesh) {
       double first = INFINITY;
       for (int p = 0; p < net.node_count; ++p) {
         const Eigen::Vector3d u = net.rest.col(p) - stylus.start;
-        if (std::abs(u.dot(e)) <= 0.5 * stylus.blade->length + tolerance && std::abs(u.dot(lateral)) <= 0.5 * h + tolerance &&
+        if (std::abs(u.dot(e)) <= 0.5 * stylus.blade->edge_length + tolerance && std::abs(u.dot(lateral)) <= 0.5 * h + tolerance &&
             u.dot(c) >= -tolerance) {
           under.push_back(p);
           first = std::min(first, u.dot(c));

@@ -3,6 +3,7 @@
 // the styluses, pruned to the body, fixed where the body is supported, with the nodes under each
 // stylus tip attached to it; stepped by a selectable integrator; torn past the tensile limit.
 
+#include "meshes/blade_shape.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "realtime/springs/newton_stepper.hpp"
 #include "realtime/springs/spring_network.hpp"
@@ -39,18 +40,11 @@ struct SpringSupport {
   bool sliding = false;
 };
 
-/// A blade's edge pressing the network: the deformation phase of a cutting scene (paper 001's
-/// deformation before rupture), the edge a straight segment of `length` [m] along the unit
-/// `edge_direction`, moving along the unit `cutting_direction` (orthogonal to it). The network
-/// does not cut: past the rupture point its response is the uncut body's.
-struct SpringBladeEdge {
-  Eigen::Vector3d edge_direction = Eigen::Vector3d::UnitY();
-  Eigen::Vector3d cutting_direction = -Eigen::Vector3d::UnitZ();
-  double length = 0.0;
-};
-
 /// A tool: a stylus, its tip centre at the first sample [m] and tip radius [m]; or, with
-/// `blade`, a blade whose edge midpoint is at `start` at the first sample (radius unused).
+/// `blade`, a blade whose edge midpoint is at `start` at the first sample (radius unused): its
+/// edge (edge_direction, cutting_direction, edge_length; the wedge is not used) presses the
+/// network, the deformation phase of a cutting scene (paper 001's deformation before rupture).
+/// The network does not cut: past the rupture point its response is the uncut body's.
 /// A stylus with `grasp_stiffness` k > 0 grasps compliantly (docs/spring-network.md §3,
 /// "Compliant grasp"; the scene's grasp_stiffness and grasp_radius): the disc of radius
 /// `grasp_disc_radius` a on the face the tip touches, centred at the contact point, is held to
@@ -60,7 +54,7 @@ struct SpringBladeEdge {
 struct SpringStylus {
   Eigen::Vector3d start = Eigen::Vector3d::Zero();
   double radius = 0.0;
-  std::optional<SpringBladeEdge> blade = std::nullopt;
+  std::optional<BladeShape> blade = std::nullopt;
   double grasp_stiffness = 0.0;   ///< k [N/m³]; 0: the rigid grasp
   double grasp_disc_radius = 0.0; ///< a [m] > 0 with grasp_stiffness
 };

@@ -10,13 +10,13 @@
 
 namespace kerf::reference {
 
-std::vector<std::pair<Eigen::Vector3d, double>> blade_edge_points(const RigidToolShape& blade,
+std::vector<std::pair<Eigen::Vector3d, double>> blade_edge_points(const RigidToolShape& tool,
                                                                   const Eigen::Vector3d& position, double spacing) {
-  if (blade.kind != RigidToolShape::Kind::wedge)
+  if (tool.kind != RigidToolShape::Kind::wedge)
     throw std::invalid_argument("blade edge contact: the tool is not a wedge (blade)");
   if (!(spacing > 0.0) || !std::isfinite(spacing))
     throw std::invalid_argument("blade edge contact: point spacing must be positive, got " + std::to_string(spacing));
-  const double L = blade.edge_length;
+  const double L = tool.blade.edge_length;
   const auto segments = static_cast<int>(std::ceil(L / spacing));
   if (segments > 1000000)
     throw std::invalid_argument("blade edge contact: point spacing " + std::to_string(spacing) +
@@ -26,12 +26,12 @@ std::vector<std::pair<Eigen::Vector3d, double>> blade_edge_points(const RigidToo
   for (int k = 0; k <= segments; ++k) {
     // p_k = c + (−L/2 + k L/n) e, trapezoid weight
     const double s = -0.5 * L + w * k;
-    points.emplace_back(position + s * blade.edge_direction, (k == 0 || k == segments) ? 0.5 * w : w);
+    points.emplace_back(position + s * tool.blade.edge_direction, (k == 0 || k == segments) ? 0.5 * w : w);
   }
   return points;
 }
 
-BladeEdgeContact blade_edge_contact(const RigidToolShape& blade, const Eigen::Vector3d& position,
+BladeEdgeContact blade_edge_contact(const RigidToolShape& tool, const Eigen::Vector3d& position,
                                     std::span<const BoundaryFacet> facets,
                                     std::span<const Eigen::Vector3d> reference_positions,
                                     std::span<const double> displacement, const BladeEdgeContactSettings& settings) {
@@ -40,7 +40,7 @@ BladeEdgeContact blade_edge_contact(const RigidToolShape& blade, const Eigen::Ve
   if (displacement.size() != 3 * reference_positions.size())
     throw std::invalid_argument("blade edge contact: " + std::to_string(displacement.size()) +
                                 " displacement entries for " + std::to_string(reference_positions.size()) + " nodes");
-  const auto points = blade_edge_points(blade, position, settings.point_spacing);
+  const auto points = blade_edge_points(tool, position, settings.point_spacing);
   BladeEdgeContact out;
   out.sampled_points = static_cast<int>(points.size());
   const auto node_count = static_cast<int>(reference_positions.size());

@@ -56,11 +56,11 @@ struct BladeEdgeContact {
   double max_line_load = 0.0;  ///< max ε_L d [N/m]
 };
 
-/// The edge points of a wedge `blade` whose edge midpoint is at `position`: n = ⌈L/s⌉ + 1 points
+/// The edge points of a wedge `tool` whose edge midpoint is at `position`: n = ⌈L/s⌉ + 1 points
 /// evenly spaced over the edge length L (s the spacing), with trapezoid weights (L/(n−1), halved
-/// at the ends). Throws std::invalid_argument if the blade is not a wedge or the spacing is not
+/// at the ends). Throws std::invalid_argument if the tool is not a wedge or the spacing is not
 /// positive.
-std::vector<std::pair<Eigen::Vector3d, double>> blade_edge_points(const RigidToolShape& blade,
+std::vector<std::pair<Eigen::Vector3d, double>> blade_edge_points(const RigidToolShape& tool,
                                                                   const Eigen::Vector3d& position, double spacing);
 
 /// Evaluates the edge pass (see file comment) on the body whose node k sits at
@@ -69,7 +69,7 @@ std::vector<std::pair<Eigen::Vector3d, double>> blade_edge_points(const RigidToo
 /// smallest distance to it — so a point under a concave fold (two facets tied on their shared
 /// edge) is inside, a point beside a convex ridge is not. Throws std::invalid_argument on bad
 /// settings or a facet node out of range.
-BladeEdgeContact blade_edge_contact(const RigidToolShape& blade, const Eigen::Vector3d& position,
+BladeEdgeContact blade_edge_contact(const RigidToolShape& tool, const Eigen::Vector3d& position,
                                     std::span<const BoundaryFacet> facets,
                                     std::span<const Eigen::Vector3d> reference_positions,
                                     std::span<const double> displacement, const BladeEdgeContactSettings& settings);

@@ -1,5 +1,7 @@
 #include "reference/contact/point_triangle_distance.hpp"
 
+#include "meshes/triangle_closest_point.hpp"
+
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
@@ -11,42 +13,24 @@ namespace kerf::reference {
 
 namespace {
 
-/// The closest point's feature and barycentric coordinates (Ericson 2005, §5.1.5). Returns, for
-/// an edge, the index of the vertex off the edge (else −1).
+/// The closest point's kind of feature and barycentric coordinates (the shared Voronoi-region
+/// tests of meshes/triangle_closest_point.hpp, Ericson 2005, §5.1.5). Returns, for an edge, the
+/// index of the vertex off the edge (else −1).
 int closest_feature(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                     const Eigen::Vector3d& c, PointTriangleDistance& out) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  auto set = [&](TriangleFeature f, double l0, double l1, double l2, int off = -1) {
-    out.feature = f;
-    out.barycentric = {l0, l1, l2};
-    return off;
-  };
-  if (d1 <= 0.0 && d2 <= 0.0) return set(TriangleFeature::vertex, 1.0, 0.0, 0.0);
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return set(TriangleFeature::vertex, 0.0, 1.0, 0.0);
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
-    const double v = d1 / (d1 - d3);
-    return set(TriangleFeature::edge, 1.0 - v, v, 0.0, 2);
+  const TriangleClosestPoint closest = closest_point_on_triangle(p, a, b, c);
+  out.barycentric = closest.barycentric;
+  switch (closest.feature) {
+  case kerf::TriangleFeature::vertex_a:
+  case kerf::TriangleFeature::vertex_b:
+  case kerf::TriangleFeature::vertex_c: out.feature = TriangleFeature::vertex; return -1;
+  case kerf::TriangleFeature::edge_bc: out.feature = TriangleFeature::edge; return 0;
+  case kerf::TriangleFeature::edge_ca: out.feature = TriangleFeature::edge; return 1;
+  case kerf::TriangleFeature::edge_ab: out.feature = TriangleFeature::edge; return 2;
+  case kerf::TriangleFeature::face: break;
   }
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return set(TriangleFeature::vertex, 0.0, 0.0, 1.0);
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
-    const double w = d2 / (d2 - d6);
-    return set(TriangleFeature::edge, 1.0 - w, 0.0, w, 1);
-  }
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
-    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return set(TriangleFeature::edge, 0.0, 1.0 - w, w, 0);
-  }
-  const double denom = 1.0 / (va + vb + vc);
-  const double v = vb * denom, w = vc * denom;
-  return set(TriangleFeature::face, 1.0 - v - w, v, w);
+  out.feature = TriangleFeature::face;
+  return -1;
 }
 
 } // namespace

@@ -20,7 +20,8 @@
 
 namespace kerf::reference {
 
-/// Which feature of the triangle holds the closest point.
+/// Which kind of feature of the triangle holds the closest point (its number of free coordinates:
+/// two, one, none); kerf::TriangleFeature (meshes/triangle_closest_point.hpp) names which one.
 enum class TriangleFeature { face, edge, vertex };
 
 /// d² of a point to a triangle and its derivatives with respect to the vertices (x0, x1, x2),

@@ -82,11 +82,11 @@ TEST(PointTriangleDistance, DegenerateTriangleIsRefused) {
 RigidToolShape blade_along_y(double length) {
   RigidToolShape b;
   b.kind = RigidToolShape::Kind::wedge;
-  b.edge_direction = Eigen::Vector3d::UnitY();
-  b.cutting_direction = -Eigen::Vector3d::UnitZ();
-  b.wedge_angle = 15.0 * std::numbers::pi / 180.0;
-  b.thickness = 1e-4;
-  b.edge_length = length;
+  b.blade.edge_direction = Eigen::Vector3d::UnitY();
+  b.blade.cutting_direction = -Eigen::Vector3d::UnitZ();
+  b.blade.wedge_angle = 15.0 * std::numbers::pi / 180.0;
+  b.blade.thickness = 1e-4;
+  b.blade.edge_length = length;
   return b;
 }
 
@@ -143,8 +143,8 @@ TEST(BladeEdgeContact, TangentMatchesFiniteDifferencesOnAFold) {
     // (0.047, not 0.05: no edge point may sit exactly on the surface, where W is only C¹ and a
     // central difference straddles the kink of the tangent.)
     RigidToolShape blade = blade_along_y(0.6);
-    blade.edge_direction = edge;
-    blade.cutting_direction = Eigen::Vector3d(0, 0, -1);
+    blade.blade.edge_direction = edge;
+    blade.blade.cutting_direction = Eigen::Vector3d(0, 0, -1);
     const BladeEdgeContact c = blade_edge_contact(blade, where, sq.facets, sq.X, u, s);
     ASSERT_GT(c.active_points, 0);
     Eigen::MatrixXd K = Eigen::MatrixXd::Zero(12, 12);

@@ -60,11 +60,11 @@ FiniteStrainProblem bladed_block() {
   FiniteStrainProblem p = pressed_block();
   RigidToolShape blade;
   blade.kind = RigidToolShape::Kind::wedge;
-  blade.edge_direction = Eigen::Vector3d::UnitY();
-  blade.cutting_direction = -Eigen::Vector3d::UnitZ();
-  blade.wedge_angle = 15.0 * std::numbers::pi / 180.0;
-  blade.thickness = 1e-4;
-  blade.edge_length = 0.03;
+  blade.blade.edge_direction = Eigen::Vector3d::UnitY();
+  blade.blade.cutting_direction = -Eigen::Vector3d::UnitZ();
+  blade.blade.wedge_angle = 15.0 * std::numbers::pi / 180.0;
+  blade.blade.thickness = 1e-4;
+  blade.blade.edge_length = 0.03;
   p.tool = blade;
   return p;
 }

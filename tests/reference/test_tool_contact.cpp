@@ -27,8 +27,8 @@ TEST(RigidTool, SpherePenetrationAndNormal) {
 TEST(RigidTool, WedgeNearestExit) {
   RigidToolShape w;
   w.kind = RigidToolShape::Kind::wedge;
-  w.wedge_angle = std::numbers::pi / 2.0; // 90°: flanks at 45°
-  w.thickness = 10e-3;
+  w.blade.wedge_angle = std::numbers::pi / 2.0; // 90°: flanks at 45°
+  w.blade.thickness = 10e-3;
   // Edge along y at the origin cutting down (−z): a point 1 mm above the edge on its axis is
   // inside, nearest exit through a flank at distance 1 mm · sin 45°.
   const ToolContactPoint c = tool_contact(w, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1e-3));
@@ -38,15 +38,15 @@ TEST(RigidTool, WedgeNearestExit) {
   // Ahead of the edge (below it) is outside.
   EXPECT_FALSE(tool_contact(w, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -1e-4)).inside);
   RigidToolShape bad = w;
-  bad.wedge_angle = 0.0;
+  bad.blade.wedge_angle = 0.0;
   EXPECT_THROW(validate(bad), std::invalid_argument);
 }
 
 TEST(RigidTool, WedgePushesACrackFaceToItsOwnSide) {
   RigidToolShape w;
   w.kind = RigidToolShape::Kind::wedge;
-  w.wedge_angle = std::numbers::pi / 2.0; // flanks at 45°
-  w.thickness = 10e-3;
+  w.blade.wedge_angle = std::numbers::pi / 2.0; // flanks at 45°
+  w.blade.thickness = 10e-3;
   // Edge along y cutting down (−z): m = e × d = −x; flank normals (−sin45, 0, −sin45)·… i.e.
   // n₁ = sin45 (−z) + cos45 (−x), n₂ = sin45 (−z) + cos45 (+x). A point 0.1 mm on the −x side of
   // the blade plane, 1 mm above the edge: its nearest exit is flank n₁ (towards −x), at

@@ -74,8 +74,7 @@ LiveViewReport session(const std::string& scene_name, const std::string& model_n
   s.frame.title = scene_name + " / " + model_name;
   for (const Tool& tool : scene.tools) {
     s.frame.tool_names.push_back(tool.name);
-    s.frame.tools.push_back({tool.kind == Tool::Kind::blade, tool.radius, tool.blade.edge_direction,
-                             tool.blade.cutting_direction, tool.blade.edge_length});
+    s.frame.tools.push_back({tool.kind == Tool::Kind::blade, tool.radius, tool.blade});
   }
   return run_live_view(*built.model, built.core_model(), mesh, raw, s);
 }

@@ -10,9 +10,9 @@ namespace kerf::test {
 inline ShapeFormingSetup clay_setup() {
   constexpr double E = 0.5e6, nu = 0.45; // clay_form.toml's estimates
   ShapeFormingSetup s;
-  s.edge.edge_direction = Eigen::Vector3d::UnitY();
-  s.edge.cutting_direction = -Eigen::Vector3d::UnitZ();
-  s.edge.edge_length = 0.050;
+  s.edge.blade.edge_direction = Eigen::Vector3d::UnitY();
+  s.edge.blade.cutting_direction = -Eigen::Vector3d::UnitZ();
+  s.edge.blade.edge_length = 0.050;
   s.edge.point_count = 100;
   s.edge.materials = {{E / (1.0 - nu * nu), 50.0, 10.0 / (1.0 - nu * nu)}};
   s.voxel_size = 6.25e-4;

@@ -24,7 +24,7 @@ EdgeMaterial material(double stiffness_per_length, double shear_per_length, doub
 
 DiscreteEdgeSetup setup(double length, int k, EdgeMaterial m, double mu = 0.0) {
   DiscreteEdgeSetup s;
-  s.edge_length = length;
+  s.blade.edge_length = length;
   s.point_count = k;
   s.materials = {m};
   s.friction_coefficient = mu;

@@ -219,16 +219,11 @@ TEST(GeometricCut, TwoCutsMakeFourQuarters) {
   expect_sound(body, 1.0);
 }
 
-TEST(SweptSurface, StripOfTrianglesAndClosestPoint) {
+TEST(SweptSurface, StripOfTriangles) {
   const std::vector<Eigen::Vector3d> centres{{0, 0, 1}, {0, 0, 0}, {0, 0, -1}};
   const SweptSurface s = sweep_edge(centres, Eigen::Vector3d::UnitY(), 2.0);
   EXPECT_EQ(s.triangles.rows(), 4);
   EXPECT_EQ(s.vertices.rows(), 6);
   EXPECT_TRUE(s.vertices.row(1).isApprox(Eigen::RowVector3d(0, 1, 1)));
-  // Closest points: interior (projection), an edge, a vertex — by hand.
-  const Eigen::Vector3d a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
-  EXPECT_TRUE(closest_point_on_triangle({0.2, 0.2, 3}, a, b, c).isApprox(Eigen::Vector3d(0.2, 0.2, 0)));
-  EXPECT_TRUE(closest_point_on_triangle({0.5, -1, 0}, a, b, c).isApprox(Eigen::Vector3d(0.5, 0, 0)));
-  EXPECT_TRUE(closest_point_on_triangle({-1, -1, 0}, a, b, c).isApprox(a));
   EXPECT_THROW(sweep_edge(std::vector<Eigen::Vector3d>{{0, 0, 0}}, Eigen::Vector3d::UnitY(), 1.0), std::invalid_argument);
 }

@@ -31,7 +31,7 @@ TEST(RealtimeContract, DiscreteEdgeModelStepAllocatesNothing) {
   TetMesh mesh = box_tet_mesh({0.0, -0.010, 0.0}, {0.040, 0.010, 0.015}, 8, 4, 5);
   add_height_layers(mesh, 0.009);
   DiscreteEdgeSetup s;
-  s.edge_length = 0.030;
+  s.blade.edge_length = 0.030;
   s.point_count = 64;
   s.materials = {{1e6, 500.0, 20.0}, {1e6, 200.0, 20.0}};
   s.friction_coefficient = 0.3;
@@ -72,7 +72,7 @@ TEST(RealtimeContract, EdgeModelStepAllocatesNothingWhileTheGeometricCutRuns) {
   // after-cut hook keeps it busy until the servo thread has stepped 1000 times while it was busy. Then the body is in two halves of 20 x 20 x 15 mm each.
   const TetMesh mesh = box_tet_mesh({0.0, -0.010, 0.0}, {0.040, 0.010, 0.015}, 32, 16, 12);
   DiscreteEdgeSetup s;
-  s.edge_length = 0.030;
+  s.blade.edge_length = 0.030;
   s.point_count = 64;
   s.materials = {{1e6, 500.0, 20.0}};
   DiscreteEdgeCuttingModel model(CollisionVoxels(mesh, 5e-4), s);
@@ -80,9 +80,7 @@ TEST(RealtimeContract, EdgeModelStepAllocatesNothingWhileTheGeometricCutRuns) {
   auto hold = [&](const CuttableBody&, const GeometricCutReport&) {
     while (!release.load()) std::this_thread::yield();
   };
-  model.attach_geometric_cut(std::make_unique<BackgroundCut>(mesh, RecordedEdge{Eigen::Vector3d::UnitY(), 0.030},
-                                                             GeometricCutOptions{}, 4096, hold),
-                             5e-4);
+  model.attach_geometric_cut(std::make_unique<BackgroundCut>(mesh, s.blade, GeometricCutOptions{}, 4096, hold), 5e-4);
 
   allocations = 0;
   ToolState tool;

@@ -20,9 +20,9 @@ TetMesh potato_box() { return box_tet_mesh({0.0, -0.010, 0.0}, {0.040, 0.010, 0.
 
 FractureCuttingSetup razor(double toughness = 200.0) {
   FractureCuttingSetup s;
-  s.edge_direction = Eigen::Vector3d::UnitY();
-  s.cutting_direction = -Eigen::Vector3d::UnitZ();
-  s.edge_length = 0.030;
+  s.blade.edge_direction = Eigen::Vector3d::UnitY();
+  s.blade.cutting_direction = -Eigen::Vector3d::UnitZ();
+  s.blade.edge_length = 0.030;
   s.fracture_toughness = {toughness};
   s.response.rupture_force_per_length = 400.0; // f_r [N/m]
   s.response.rupture_deflection = 0.002;       // δ_r
@@ -263,7 +263,7 @@ TEST(FractureCuttingModel, RejectsOutOfRangeParameters) {
   s.response.crack_deflection = 0.0;
   EXPECT_THROW(FractureCuttingModel(potato_box(), s), std::invalid_argument);
   s = razor();
-  s.cutting_direction = Eigen::Vector3d::UnitY();
+  s.blade.cutting_direction = Eigen::Vector3d::UnitY();
   EXPECT_THROW(FractureCuttingModel(potato_box(), s), std::invalid_argument);
   s = razor();
   s.fracture_toughness = {-1.0};

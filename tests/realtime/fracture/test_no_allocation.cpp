@@ -24,7 +24,7 @@ TEST(RealtimeContract, FractureModelStepAllocatesNothing) {
   add_height_layers(mesh, 0.009);
 
   FractureCuttingSetup s;
-  s.edge_length = 0.030;
+  s.blade.edge_length = 0.030;
   s.regions = {"layer_upper", "layer_lower"};
   s.fracture_toughness = {600.0, 200.0};
   s.response = {400.0, 0.002, 2, 0.0005, 1, 2000.0, 5000.0, 0.5};

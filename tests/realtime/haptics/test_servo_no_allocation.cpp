@@ -33,7 +33,7 @@ using namespace kerf;
 TEST(RealtimeContract, ServoTickAllocatesNothing) {
   TetMesh mesh = box_tet_mesh({0.0, -0.010, 0.0}, {0.040, 0.010, 0.015}, 8, 4, 5);
   FractureCuttingSetup s;
-  s.edge_length = 0.030;
+  s.blade.edge_length = 0.030;
   s.fracture_toughness = {200.0};
   s.response = {300.0, 0.0015, 2, 0.0003, 1, 2000.0, 5000.0, 0.5};
   s.friction = true;

@@ -88,7 +88,9 @@ TEST(RealtimeContract, BladePressAllocatesNothing) {
   const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.04, 0.01, 0.015}, 16, 8, 6);
   for (const SpringIntegrator integrator : {SpringIntegrator::symplectic_euler, SpringIntegrator::implicit_euler}) {
     SpringNetworkSetup s = test::clay_pull_setup(integrator);
-    s.styluses = {{Eigen::Vector3d(0.02, 0.0, 0.016), 0.0, SpringBladeEdge{Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ(), 0.03}}};
+    s.styluses = {{Eigen::Vector3d(0.02, 0.0, 0.016), 0.0, BladeShape{.edge_direction = Eigen::Vector3d::UnitY(),
+        .cutting_direction = -Eigen::Vector3d::UnitZ(),
+        .edge_length = 0.03}}};
     SpringNetworkModel model(mesh, s);
     std::vector<std::vector<ToolState>> path(301, std::vector<ToolState>(1));
     for (int k = 0; k <= 300; ++k) path[static_cast<std::size_t>(k)][0].position = {0.02, 0.0, 0.016 - 1e-5 * k};

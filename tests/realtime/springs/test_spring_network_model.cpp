@@ -79,7 +79,9 @@ TEST(SpringNetworkModel, BladePressesOnlyOnceItsEdgeArrives) {
   const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.04, 0.01, 0.015}, 16, 8, 6);
   SpringNetworkSetup s = test::clay_pull_setup(SpringIntegrator::quasi_static);
   s.youngs_modulus = 3e6;
-  s.styluses = {{Eigen::Vector3d(0.02, 0.0, 0.016), 0.0, SpringBladeEdge{Eigen::Vector3d::UnitY(), -Eigen::Vector3d::UnitZ(), 0.03}}};
+  s.styluses = {{Eigen::Vector3d(0.02, 0.0, 0.016), 0.0, BladeShape{.edge_direction = Eigen::Vector3d::UnitY(),
+      .cutting_direction = -Eigen::Vector3d::UnitZ(),
+      .edge_length = 0.03}}};
   SpringNetworkModel model(mesh, s);
   // The block covers the edge's 20 mm span in the body: h = 20 mm / 8; the first layer under the
   // edge is the top face's line x = 20 mm, y in [-10, 10] mm: 9 nodes.
