@@ -32,7 +32,7 @@ TEST(GraspFoundation, ColumnUnderUniaxialStrainIsTwoSpringsInSeries) {
     p.displacement_boundaries.push_back({s, DisplacementBoundary::Kind::sliding, {}, {}});
   p.foundations.push_back({"zmax", k, [&](const Eigen::Vector3d&, double load) -> Eigen::Vector3d {
                              return {0.0, 0.0, load * delta};
-                           }});
+                           }, {}}); // {}: a uniform layer
   for (const int degree : {1, 2}) {
     SCOPED_TRACE(degree);
     SolverSettings settings;
@@ -96,7 +96,7 @@ TEST(GraspFoundation, AStiffLayerRecoversTheRigidTie) {
   for (const double k : {1e2 * E / h, 1e3 * E / h, 1e4 * E / h}) {
     SCOPED_TRACE(k);
     FiniteStrainProblem compliant = base;
-    compliant.foundations.push_back({"patch", k, up});
+    compliant.foundations.push_back({"patch", k, up, {}}); // {}: a uniform layer
     const EquilibriumReport rc = solve(compliant);
     const double difference = (rc.foundation_forces[0] - F_tied).norm() / F_tied.norm();
     EXPECT_LT(rc.foundation_forces[0].norm(), F_tied.norm()); // a compliant grasp is softer
@@ -117,8 +117,8 @@ TEST(GraspFoundation, BadInputIsRefusedByName) {
   p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::bonded, {}, {}});
   auto zero = [](const Eigen::Vector3d&, double) -> Eigen::Vector3d { return Eigen::Vector3d::Zero(); };
   FiniteStrainProblem unknown = p, soft = p;
-  unknown.foundations.push_back({"nowhere", 1e9, zero});
-  soft.foundations.push_back({"zmax", 0.0, zero});
+  unknown.foundations.push_back({"nowhere", 1e9, zero, {}});
+  soft.foundations.push_back({"zmax", 0.0, zero, {}});
   for (const FiniteStrainProblem* bad : {&unknown, &soft}) {
     try {
       FiniteStrainSolver solver(*bad, SolverSettings{});
