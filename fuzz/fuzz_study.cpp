@@ -39,7 +39,11 @@ void fuzz_study(std::span<const std::byte> data) {
     for (const std::string& model : spec.models)
       if (find_model(model) == nullptr) throw FuzzFinding("a study was accepted with a model not in the catalogue");
     const StudyReferenceSpec& r = spec.reference;
-    if (r.degree != 1 && r.degree != 2) throw FuzzFinding("a study was accepted with a degree other than 1 or 2");
+    if (r.degree && *r.degree != 1 && *r.degree != 2) throw FuzzFinding("a study was accepted with a degree other than 1 or 2");
+    for (const auto& [scene, degree] : r.scene_degree)
+      if (degree != 1 && degree != 2) throw FuzzFinding("a study was accepted with a scene degree other than 1 or 2");
+    for (const auto& [scene, samples] : r.scene_samples)
+      if (samples < 2) throw FuzzFinding("a study was accepted with fewer than 2 reference samples for a scene");
     if (r.refinements.empty() || std::any_of(r.refinements.begin(), r.refinements.end(), [](int l) {
           return l < minimum_study_mesh_level || l > 4;
         }))

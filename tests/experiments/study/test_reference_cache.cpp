@@ -99,7 +99,7 @@ TEST(ReferenceCache, UnchangedInputsGiveTheSameKey) {
   EXPECT_EQ(ka.directory, kb.directory);
   // The readable prefix: scene hash, degree, level, samples; then the hash of the whole key.
   EXPECT_EQ(ka.directory.substr(0, 16), file_sha256(a.file).substr(0, 16));
-  EXPECT_NE(ka.directory.find("-p1-L0-n6-"), std::string::npos) << ka.directory;
+  EXPECT_NE(ka.directory.find("-p2-L0-n6-"), std::string::npos) << ka.directory; // clay_pull's own degree, 2
   // Write-only settings (field files, checkpoints) do not change the reference's numbers.
   ReferenceRunSettings s = settings_of(a, spec, 0);
   s.write_fields = true;
@@ -114,7 +114,7 @@ TEST(ReferenceCache, EveryNumberChangingInputMissesTheCache) {
   const std::string base = reference_cache_key(nominal, settings_of(nominal, spec, 0)).directory;
   // Each change below changes what the reference computes; each must give a key of its own.
   const std::pair<std::string, std::function<ReferenceCacheKey()>> changes[] = {
-      {"degree", [&] { StudyReferenceSpec s = spec; s.degree = 2; return reference_cache_key(nominal, settings_of(nominal, s, 0)); }},
+      {"degree", [&] { StudyReferenceSpec s = spec; s.degree = 1; return reference_cache_key(nominal, settings_of(nominal, s, 0)); }},
       {"level", [&] {
          const Scene finer = study_reference_scene(nominal, 1);
          return reference_cache_key(finer, settings_of(finer, spec, 1));
@@ -160,7 +160,7 @@ TEST(ReferenceCache, TheKeyNamesTheSolverSettings) {
   const Scene level1 = study_reference_scene(scene, 1);
   EXPECT_DOUBLE_EQ(level1.geometry.element_size, 0.5 * scene.geometry.element_size);
   const std::string text = reference_cache_key(level1, settings_of(level1, spec, 1)).text;
-  for (const char* line : {"degree = 1\n", "refinements = 0\n", "linear_solver = direct\n", "fracture = off\n", "processes = 1\n",
+  for (const char* line : {"degree = 2\n", "refinements = 0\n", "linear_solver = direct\n", "fracture = off\n", "processes = 1\n",
                            "newton_relative_tolerance = ", "iterative_tolerance = ", "contact_penalty = automatic\n",
                            "max_cutbacks = ", "max_newton_iterations = ", "trajectory_sha256 = "})
     EXPECT_NE(text.find(line), std::string::npos) << line << " not in\n" << text;
