@@ -8,6 +8,8 @@
 
 #include <algorithm>
 #include <limits>
+#include <map>
+#include <string_view>
 #include <system_error>
 
 namespace kerf {
@@ -116,20 +118,26 @@ StudySpec read_study(const std::filesystem::path& file) {
             read_levels(toml::node_view<const toml::node>(&levels), "reference.scene_refinements." + scene);
       }
     }
-    if (auto r = (*ref)["scene_degree"]) {
+    // A table { SCENE = integer } of the study's scenes, each value in [lo, hi].
+    auto read_scene_integers = [&](std::string_view table_key, std::int64_t lo, std::int64_t hi, const std::string& expected) {
+      std::map<std::string, int> values;
+      const std::string path = "reference." + std::string(table_key);
+      const auto r = (*ref)[table_key];
       const toml::table* t = r.as_table();
-      if (!t) fail(file, r.node()->source(), "reference.scene_degree", "expected a table { SCENE = 1 or 2 }");
-      for (const auto& [name, degree] : *t) {
+      if (!t) fail(file, r.node()->source(), path, "expected a table { SCENE = " + expected + " }");
+      for (const auto& [name, value] : *t) {
         const std::string scene(name.str());
-        const std::string key = "reference.scene_degree." + scene;
+        const std::string key = path + "." + scene;
         const bool known = std::any_of(spec.scenes.begin(), spec.scenes.end(),
                                        [&](const std::filesystem::path& p) { return p.stem().string() == scene; });
-        if (!known) fail(file, degree.source(), key, "expected a scene of study.scenes");
-        const auto v = degree.value<int64_t>();
-        if (!v || (*v != 1 && *v != 2)) fail(file, degree.source(), key, "expected 1 or 2");
-        spec.reference.scene_degree[scene] = static_cast<int>(*v);
+        if (!known) fail(file, value.source(), key, "expected a scene of study.scenes");
+        const auto v = value.value<int64_t>();
+        if (!v || *v < lo || *v > hi) fail(file, value.source(), key, "expected " + expected);
+        values[scene] = static_cast<int>(*v);
       }
-    }
+      return values;
+    };
+    if ((*ref)["scene_degree"]) spec.reference.scene_degree = read_scene_integers("scene_degree", 1, 2, "1 or 2");
     if (auto l = (*ref)["library"]) {
       const auto v = l.value<std::string>();
       if (!v || v->empty()) fail(file, l.node()->source(), "reference.library", "expected a folder, relative to the study file");
@@ -143,20 +151,9 @@ StudySpec read_study(const std::filesystem::path& file) {
         fail(file, s.node()->source(), "reference.samples", "expected an integer in 2..2147483647");
       spec.reference.samples = static_cast<int>(*v);
     }
-    if (auto r = (*ref)["scene_samples"]) {
-      const toml::table* t = r.as_table();
-      if (!t) fail(file, r.node()->source(), "reference.scene_samples", "expected a table { SCENE = N }");
-      for (const auto& [name, count] : *t) {
-        const std::string scene(name.str());
-        const std::string key = "reference.scene_samples." + scene;
-        const bool known = std::any_of(spec.scenes.begin(), spec.scenes.end(),
-                                       [&](const std::filesystem::path& p) { return p.stem().string() == scene; });
-        if (!known) fail(file, count.source(), key, "expected a scene of study.scenes");
-        const auto v = count.value<int64_t>();
-        if (!v || *v < 2 || *v > std::numeric_limits<int>::max()) fail(file, count.source(), key, "expected an integer in 2..2147483647");
-        spec.reference.scene_samples[scene] = static_cast<int>(*v);
-      }
-    }
+    if ((*ref)["scene_samples"])
+      spec.reference.scene_samples =
+          read_scene_integers("scene_samples", 2, std::numeric_limits<int>::max(), "an integer in 2..2147483647");
     if (auto s = (*ref)["linear_solver"]) {
       const auto v = s.value<std::string>();
       if (v == "auto") spec.reference.linear_solver = reference::LinearSolverChoice::automatic;
