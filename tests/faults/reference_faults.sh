@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fault injection on `kerf reference` (docs/reliability.md), through the command line
-# and nothing else: clay_pull on a 5 mm mesh (the scene as shipped, only element_size changed, so
-# one run takes seconds), 11 evenly spaced samples (checkpoints after samples 5 and 10).
+# and nothing else: clay_pull on a 5 mm mesh of linear tetrahedra (the scene as shipped, only
+# element_size and element_degree changed, so one run takes seconds), 11 evenly spaced samples
+# (checkpoints after samples 5 and 10).
 #   1. an uninterrupted run: the profile every other run must reproduce;
 #   2. SIGKILL at seeded random times (five kills), each followed by `--resume`: after
 #      every kill, no output under a final name is half written; the final profile equals the
@@ -25,8 +26,9 @@ mkdir -p "$work"
 cd "$work"
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
-sed 's/^element_size = "2.5 mm"/element_size = "5 mm"/' "$scenes/clay_pull.toml" > coarse.toml
+sed -e 's/^element_size = "2.5 mm"/element_size = "5 mm"/' -e 's/^element_degree = 2 /element_degree = 1 /' "$scenes/clay_pull.toml" > coarse.toml
 grep -q '^element_size = "5 mm"' coarse.toml || fail "clay_pull.toml has no element_size line to coarsen"
+grep -q '^element_degree = 1 ' coarse.toml || fail "clay_pull.toml has no element_degree line to set to linear"
 samples=11 # evenly spaced, adaptive sampling off: the counts below are known
 
 # Every output under a final name is whole: the profile's rows have 11 columns and end in a
