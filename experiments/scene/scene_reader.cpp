@@ -4,6 +4,7 @@
 #include "experiments/scene/scene_reader.hpp"
 
 #include "experiments/scene/quantity.hpp"
+#include "experiments/scene/toml_keys.hpp"
 
 #include <toml++/toml.h>
 
@@ -55,15 +56,6 @@ struct TableRef {
   }
   [[nodiscard]] const toml::node* find(std::string_view k) const { return table.get(k); }
 };
-
-std::string join(std::initializer_list<std::string_view> words) {
-  std::string out;
-  for (std::string_view w : words) {
-    if (!out.empty()) out += ", ";
-    out += w;
-  }
-  return out;
-}
 
 std::string type_name(const toml::node& n) {
   switch (n.type()) {
@@ -224,14 +216,12 @@ private:
   /// Every key of `t` must be one of `allowed`.
   void allow_only(const TableRef& t, std::initializer_list<std::string_view> allowed,
                   std::string_view what = "") const {
-    for (auto&& [k, v] : t.table) {
-      bool known = false;
-      for (std::string_view a : allowed) known = known || k.str() == a;
-      if (known) continue;
-      const toml::source_region at = k.source().begin.line != 0 ? k.source() : where(v, t);
+    const toml::node* value = nullptr;
+    if (const toml::key* k = first_unknown_key(t.table, allowed, &value)) {
+      const toml::source_region at = k->source().begin.line != 0 ? k->source() : where(*value, t);
       std::string message = "unknown key";
       if (!what.empty()) message += std::string(" for ") + std::string(what);
-      fail(at, t.key(k.str()), message + " (expected one of: " + join(allowed) + ")");
+      fail(at, t.key(k->str()), message + " (expected one of: " + allowed_keys_text(allowed) + ")");
     }
   }
 

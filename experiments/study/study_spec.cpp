@@ -3,6 +3,7 @@
 #include "experiments/calibration/free_parameters.hpp"
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/study/model_resolution.hpp"
+#include "experiments/scene/toml_keys.hpp"
 
 #include <toml++/toml.h>
 
@@ -24,15 +25,9 @@ namespace {
 
 void allow_only(const std::filesystem::path& file, const toml::table& t, const std::string& prefix,
                 std::initializer_list<std::string_view> keys) {
-  for (const auto& [k, v] : t) {
-    bool known = false;
-    for (std::string_view a : keys) known = known || k.str() == a;
-    if (!known) {
-      std::string expected;
-      for (std::string_view a : keys) expected += (expected.empty() ? "" : ", ") + std::string(a);
-      fail(file, v.source(), prefix + std::string(k.str()), "unknown key (expected one of: " + expected + ")");
-    }
-  }
+  const toml::node* value = nullptr;
+  if (const toml::key* k = first_unknown_key(t, keys, &value))
+    fail(file, value->source(), prefix + std::string(k->str()), "unknown key (expected one of: " + allowed_keys_text(keys) + ")");
 }
 
 std::vector<std::string> strings(const std::filesystem::path& file, const toml::table& t, const std::string& key,
