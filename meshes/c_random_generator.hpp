@@ -15,8 +15,9 @@
 namespace kerf {
 
 /// The lock of the C library's random number generator: held around every use of gmsh
-/// (meshes/gmsh_io.cpp) and CHOLMOD's analysis with METIS among its orderings
-/// (reference/sparse_direct.cpp; the spring network orders with AMD or its own, no METIS).
+/// (meshes/gmsh_io.cpp, where it also serialises gmsh's one global model) and CHOLMOD's analysis
+/// with METIS among its orderings (reference/sparse_direct.cpp; the spring network orders with
+/// AMD or its own, no METIS).
 std::mutex& c_random_generator_mutex();
 
 } // namespace kerf

@@ -36,11 +36,6 @@ constexpr int k_gmsh_tetrahedron = 4;
 /// `DefineConstant[ NAME = {default, Name "Parameters/NAME"} ]`.
 constexpr std::string_view k_parameter_prefix = "Parameters/";
 
-/// gmsh keeps one global model and is not thread-safe: every call into it holds this lock.
-std::mutex& gmsh_mutex() {
-  static std::mutex mutex;
-  return mutex;
-}
 
 /// Initialises gmsh once per process (thread-safe function-local static) and configures it to be
 /// silent: messages go to gmsh's logger, which GmshSession reads back to build MeshError
@@ -67,7 +62,7 @@ void ensure_gmsh_initialized() {
 class GmshSession {
 public:
   explicit GmshSession(std::string file)
-      : m_lock(gmsh_mutex()), m_random_lock(c_random_generator_mutex()), m_file(std::move(file)) {
+      : m_lock(c_random_generator_mutex()), m_file(std::move(file)) {
     ensure_gmsh_initialized();
     reset();
     gmsh::logger::start();
@@ -117,8 +112,9 @@ public:
   }
 
 private:
+  // gmsh keeps one global model and is not thread-safe, and it seeds and draws from the C
+  // library's rand(): one lock serves both (meshes/c_random_generator.hpp).
   std::lock_guard<std::mutex> m_lock;
-  std::lock_guard<std::mutex> m_random_lock; // gmsh seeds and draws from the C library's rand()
   std::string m_file;
 };
 
