@@ -1,6 +1,6 @@
 #pragma once
 // FiniteStrainSolver: kerf's offline ground truth — quasi-static, total-Lagrangian finite-strain
-// elasticity on the scene's tetrahedra (FE_SimplexP of degree 1 or 2, QGaussSimplex, MappingFE;
+// elasticity on the scene's tetrahedra (FE_SimplexP of degree 1 or 2, simplex quadrature, MappingFE;
 // deal.II 9.4), Newton–Raphson with a backtracking line search, Dirichlet supports, dead-load
 // tractions and a rigid tool in penalty contact. In the spirit of deal.II's step-44 and the code
 // gallery's "Quasi-Static Finite-Strain Compressible Elasticity", written for tetrahedra.
@@ -162,7 +162,7 @@ struct SolverSettings {
   /// pattern predicts at most this many entries in the Cholesky factor (8 bytes each; UMFPACK's
   /// LU, which takes an indefinite tangent, needs several times that), else iterative; 0: never.
   double direct_factor_limit = 1e8;
-  double relative_tolerance = 1e-9;     ///< Newton: |R_free| <= rel × (|f_int| + |f_ext|) + abs
+  double relative_tolerance = 1e-9;     ///< Newton: |R_free| <= rel × F + abs, F the largest |f_int| + |f_ext| of the iteration's states
   double absolute_tolerance = 1e-12;    ///< [N]
   int max_newton_iterations = 25;
   LineSearch line_search = LineSearch::residual_norm;

@@ -29,6 +29,42 @@ void validate(const RigidToolShape& s) {
     throw std::invalid_argument("rigid tool: wedge edge_length must be positive, got " + std::to_string(s.blade.edge_length));
 }
 
+ToolHalfSpaces bounding_half_spaces(const RigidToolShape& s) {
+  ToolHalfSpaces h;
+  if (s.kind == RigidToolShape::Kind::sphere) {
+    for (int i = 0; i < 3; ++i) {
+      h.normal[static_cast<std::size_t>(2 * i)] = Eigen::Vector3d::Unit(i);
+      h.normal[static_cast<std::size_t>(2 * i + 1)] = -Eigen::Vector3d::Unit(i);
+    }
+    h.offset.fill(s.radius);
+    return h;
+  }
+  // The wedge's faces (rigid_tool.hpp): the flanks s₁, s₂, the back slab s₃, s₄, the edge's ends s₅, s₆.
+  const Eigen::Vector3d& d = s.blade.cutting_direction;
+  const Eigen::Vector3d m = s.blade.edge_direction.cross(d);
+  const double phi = 0.5 * s.blade.wedge_angle;
+  const Eigen::Vector3d& e = s.blade.edge_direction;
+  h.normal = {std::sin(phi) * d + std::cos(phi) * m, std::sin(phi) * d - std::cos(phi) * m, m, -m, e, -e};
+  // An edge_length of 0 (a shape that skipped validate) leaves the wedge unbounded along e.
+  const double half_length = s.blade.edge_length > 0.0 ? 0.5 * s.blade.edge_length : std::numeric_limits<double>::infinity();
+  h.offset = {0.0, 0.0, 0.5 * s.blade.thickness, 0.5 * s.blade.thickness, half_length, half_length};
+  return h;
+}
+
+bool outside_together(const ToolHalfSpaces& h, const Eigen::Vector3d& position, std::span<const Eigen::Vector3d> points) {
+  if (points.empty()) return true;
+  for (std::size_t k = 0; k < h.normal.size(); ++k) {
+    bool all = true;
+    for (const Eigen::Vector3d& x : points)
+      if (!((x - position).dot(h.normal[k]) >= h.offset[k])) {
+        all = false;
+        break;
+      }
+    if (all) return true;
+  }
+  return false;
+}
+
 ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c, const Eigen::Vector3d& x,
                               const Eigen::Vector3d& side) {
   ToolContactPoint out;
@@ -45,15 +81,9 @@ ToolContactPoint tool_contact(const RigidToolShape& s, const Eigen::Vector3d& c,
     out.normal_derivative = (Eigen::Matrix3d::Identity() - out.normal * out.normal.transpose()) / dist;
     return out;
   }
-  const Eigen::Vector3d& d = s.blade.cutting_direction;
-  const Eigen::Vector3d m = s.blade.edge_direction.cross(d);
-  const double phi = 0.5 * s.blade.wedge_angle;
-  const Eigen::Vector3d& e = s.blade.edge_direction;
-  const std::array<Eigen::Vector3d, 6> normals{std::sin(phi) * d + std::cos(phi) * m,
-                                               std::sin(phi) * d - std::cos(phi) * m, m, -m, e, -e};
-  // An edge_length of 0 (a shape that skipped validate) leaves the wedge unbounded along e.
-  const double half_length = s.blade.edge_length > 0.0 ? 0.5 * s.blade.edge_length : std::numeric_limits<double>::infinity();
-  const std::array<double, 6> offsets{0.0, 0.0, 0.5 * s.blade.thickness, 0.5 * s.blade.thickness, half_length, half_length};
+  const ToolHalfSpaces faces = bounding_half_spaces(s);
+  const std::array<Eigen::Vector3d, 6>& normals = faces.normal;
+  const std::array<double, 6>& offsets = faces.offset;
   // Inside iff every s_k < 0 (whatever the side); the exit is the allowed face with the largest s_k.
   int face = -1;
   double largest = -std::numeric_limits<double>::infinity(), largest_any = largest;

@@ -9,6 +9,9 @@
 
 #include <Eigen/Core>
 
+#include <array>
+#include <span>
+
 namespace kerf::reference {
 
 /// The geometry of a rigid tool relative to its reference point (the sphere's centre or the
@@ -50,5 +53,22 @@ struct ToolContactPoint {
 /// (on the crack plane, at the edge), instead of one of them being pushed through the blade.
 ToolContactPoint tool_contact(const RigidToolShape& shape, const Eigen::Vector3d& position, const Eigen::Vector3d& x,
                               const Eigen::Vector3d& side = Eigen::Vector3d::Zero());
+
+/// Six half-spaces whose intersection holds the tool: a point x with
+/// normal[k] · (x − position) >= offset[k] for some k is not inside the tool (tool_contact).
+/// Wedge: its six faces s₁ … s₆ above (inside iff every sₖ < 0). Sphere: its bounding box
+/// ±(x − c)_i < R. Used to skip the contact search where a whole set of points cannot touch
+/// the tool (outside_together).
+struct ToolHalfSpaces {
+  std::array<Eigen::Vector3d, 6> normal;
+  std::array<double, 6> offset{};
+};
+[[nodiscard]] ToolHalfSpaces bounding_half_spaces(const RigidToolShape& shape);
+
+/// True when every point lies outside one and the same half-space of `h` (the tool at
+/// `position`). Then so does every convex combination of the points (a half-space is convex):
+/// no point of their convex hull is inside the tool.
+[[nodiscard]] bool outside_together(const ToolHalfSpaces& h, const Eigen::Vector3d& position,
+                                    std::span<const Eigen::Vector3d> points);
 
 } // namespace kerf::reference

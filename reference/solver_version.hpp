@@ -16,6 +16,9 @@ namespace kerf::reference {
 // 2: the cohesive interface's Newton tangent (secant only while the iteration is unsettled)
 //    changes the load path of cohesive problems.
 // 3: a grasped disc's elastic layer tapers to zero at its rim (ElasticFoundation::tapered_disc).
-inline constexpr int solver_version = 3;
+// 4: quadratic tetrahedra integrate their stresses and tangent with Witherden and Vincent's
+//    8-point rule (degree 3) instead of the 14-point one (degree 5); Newton's tolerance is taken
+//    on the largest force of the iteration's states.
+inline constexpr int solver_version = 4;
 
 } // namespace kerf::reference

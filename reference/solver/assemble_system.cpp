@@ -8,6 +8,7 @@
 // contact and foundation forces).
 
 #include "reference/solver/finite_strain_impl.hpp"
+#include "reference/solver/cell_matrix_scatter.hpp"
 #include "reference/solver/cell_tangent.hpp"
 
 #include "reference/material/finite_strain_error.hpp"
@@ -16,6 +17,9 @@
 #include <deal.II/lac/full_matrix.h>
 
 #include <array>
+#include <optional>
+#include <stdexcept>
+#include <type_traits>
 #include <cmath>
 #include <limits>
 
@@ -110,6 +114,37 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
   if (geo.nodes != 4 && geo.nodes != 10)
     throw FiniteStrainError("finite strain: " + std::to_string(geo.nodes) + " nodes per cell, expected 4 or 10 (linear or quadratic tetrahedra)");
   std::vector<double> velocity(n);
+  // The serial matrix: each cell's entries added at their places (cell_matrix_scatter.hpp).
+  constexpr bool serial_matrix = std::is_same_v<MatrixType, dealii::SparseMatrix<double>>;
+  double* K_values = nullptr;
+  if constexpr (serial_matrix)
+    if (with_matrix && !cell_scatter.empty()) K_values = CellMatrixScatter::values(K);
+  // The contact search's bound: a cell whose deformed shape lies outside one of the tool's
+  // bounding half-spaces (rigid_tool.hpp) has no boundary point inside the tool, so its faces are
+  // not searched. The deformed cell x(ξ) = Σ_a x_a N_a(ξ) (affine reference cell, P1 or P2
+  // displacement) lies in the convex hull of its Bézier control points: for P1 the nodes; for P2
+  // the vertices and, per edge (a, b) with midpoint node m, b_ab = 2 x_m − (x_a + x_b)/2 (the
+  // quadratic Bernstein form, x_m = ¼ x_a + ½ b_ab + ¼ x_b; Farin 2002, "Curves and Surfaces for
+  // CAGD", §17). The test is exact: it skips only faces whose every point is outside the tool.
+  const std::optional<ToolHalfSpaces> tool_bound =
+      tool ? std::optional<ToolHalfSpaces>(bounding_half_spaces(*tool)) : std::nullopt;
+  std::vector<Eigen::Vector3d> control(geo.nodes);
+  // P2: the two vertices of each edge node (the unit support point midway between them).
+  std::vector<std::array<unsigned, 2>> edge_ends;
+  if (geo.nodes == 10) {
+    const std::vector<dealii::Point<3>>& p = fe->base_element(0).get_unit_support_points();
+    for (unsigned k = 4; k < 10; ++k)
+      for (unsigned a = 0; a < 4; ++a)
+        for (unsigned b = a + 1; b < 4; ++b)
+          if ((0.5 * (p[a] + p[b]) - p[k]).norm() < 1e-12) edge_ends.push_back({a, b});
+    if (edge_ends.size() != 6) throw std::logic_error("finite strain: the quadratic tetrahedron's edge nodes are not edge midpoints");
+  }
+  auto cell_outside_tool = [&](const std::vector<dealii::types::global_dof_index>& dofs) {
+    for (unsigned i = 0; i < n; ++i) control[node[i]][comp[i]] = reference_coordinate[dofs[i]] + cell_u[i];
+    for (std::size_t l = 0; l < edge_ends.size(); ++l)
+      control[4 + l] = 2.0 * control[4 + l] - 0.5 * (control[edge_ends[l][0]] + control[edge_ends[l][1]]);
+    return outside_together(*tool_bound, load.tool_position, control);
+  };
 
   for (const auto& cell : dof.active_cell_iterators()) {
     if (!cell->is_locally_owned()) continue; // distributed: another process assembles it
@@ -117,7 +152,7 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
     const std::size_t c_index = cell->active_cell_index();
     for (unsigned i = 0; i < n; ++i) cell_u[i] = state(local[i]);
     cell_K = 0.0;
-    if (with_matrix) tangent.set_zero();
+    if (with_matrix) tangent.set_zero(geo.nodes);
     cell_int = 0.0;
     cell_ext = 0.0;
     const HyperelasticLaw& law = *laws[cell->material_id()];
@@ -183,6 +218,7 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
     }
 
     // Tractions and contact on boundary faces.
+    int near_tool = -1; // the cell's bound against the tool: -1 not tested yet, 0 outside, 1 may touch
     for (const unsigned f : cell->face_indices()) {
       if (!cell->face(f)->at_boundary()) continue;
       const auto id = cell->face(f)->boundary_id();
@@ -193,10 +229,12 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
           traction_sum += t;
           traction = &traction_sum;
         }
-      if (traction == nullptr && !tool) continue;
+      if (tool && near_tool < 0) near_tool = cell_outside_tool(local) ? 0 : 1;
+      const bool search = near_tool == 1;
+      if (traction == nullptr && !search) continue;
       ffv.reinit(cell, f);
-      if (tool) ffv[disp].get_function_values(state, face_u);
-      const Eigen::Vector3d side = crack_side(cell, f);
+      if (search) ffv[disp].get_function_values(state, face_u);
+      const Eigen::Vector3d side = search ? crack_side(cell, f) : Eigen::Vector3d::Zero();
       for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
         const double JxW = ffv.JxW(q);
         Eigen::Vector3d t = Eigen::Vector3d::Zero();
@@ -205,7 +243,7 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
           out.traction_on_body += load.load_factor * *traction * JxW;
         }
         Eigen::Matrix3d dt_dx = Eigen::Matrix3d::Zero();
-        if (tool) {
+        if (search) {
           const Eigen::Vector3d x = to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
           const ToolContactPoint c = tool_contact(*tool, load.tool_position, x, side);
           if (c.inside) {
@@ -226,7 +264,7 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
           const double Ni = ffv.shape_value_component(i, q, comp[i]);
           if (Ni == 0.0) continue;
           cell_ext(i) += Ni * t[comp[i]] * JxW;
-          if (with_matrix && tool)
+          if (with_matrix && search)
             for (unsigned j = 0; j < n; ++j)
               cell_K(i, j) -= Ni * dt_dx(comp[i], comp[j]) * ffv.shape_value_component(j, q, comp[j]) * JxW;
         }
@@ -236,7 +274,14 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
     f_ext.add(local, cell_ext);
     if (with_matrix) {
       for (unsigned i = 0; i < n; ++i) cell_rhs(i) = cell_ext(i) - cell_int(i);
-      constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
+      if constexpr (serial_matrix) {
+        if (K_values != nullptr)
+          cell_scatter.add(c_index, cell_K, cell_rhs, local, *constraints, K_values, *rhs);
+        else
+          constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
+      } else {
+        constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
+      }
     }
   }
   if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);

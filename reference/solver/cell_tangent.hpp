@@ -27,8 +27,9 @@ struct CellTangentBlocks {
   using Block = Eigen::Matrix<double, max_nodes, max_nodes>;
   std::array<Block, 9> block;
 
-  void set_zero() {
-    for (Block& b : block) b.setZero();
+  /// Zero the blocks' top-left nodes × nodes corners (the only part add() and complete_lower() touch).
+  void set_zero(int nodes) {
+    for (Block& b : block) b.topLeftCorner(nodes, nodes).setZero();
   }
   [[nodiscard]] Block& operator()(int c, int d) { return block[3 * c + d]; }
   [[nodiscard]] const Block& operator()(int c, int d) const { return block[3 * c + d]; }

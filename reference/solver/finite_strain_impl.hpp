@@ -25,6 +25,7 @@
 #include "reference/material/hyperelastic_law.hpp"
 #include "reference/material/kelvin_voigt.hpp"
 #include "reference/solver/algebra.hpp"
+#include "reference/solver/cell_matrix_scatter.hpp"
 #include "reference/tangent_solver.hpp"
 
 #include <deal.II/base/mpi.h>
@@ -75,9 +76,13 @@ struct FiniteStrainSolver::Impl {
   std::unique_ptr<dealii::FESystem<3>> fe;
   std::unique_ptr<dealii::MappingFE<3>> mapping;
   dealii::DoFHandler<3> dof;
-  std::unique_ptr<dealii::QGaussSimplex<3>> cell_quadrature;
+  std::unique_ptr<dealii::Quadrature<3>> cell_quadrature; // the stresses and the tangent (system_setup.cpp)
+  std::unique_ptr<dealii::Quadrature<3>> mass_quadrature; // the consistent mass matrix, exact for N_i N_j
   std::unique_ptr<dealii::QGaussSimplex<2>> face_quadrature;
   double h_min = 0.0; // the shortest edge of the (refined) mesh [m]
+  // Per DOF 3k + c: coordinate c of node k in the reference configuration [m] (the DOFs of
+  // artificial cells of a distributed mesh: 0).
+  std::vector<double> reference_coordinate;
 
   // The reference geometry of every cell, computed once (total Lagrangian: the shape gradients
   // with respect to X and the weights JxW never change): per active cell index, the scalar
@@ -132,6 +137,7 @@ struct FiniteStrainSolver::Impl {
 
   // ---- The linear algebra (algebra.hpp) and the linear solver (tangent_solver.hpp) ---------------
   SerialAlgebra serial;
+  CellMatrixScatter cell_scatter; // serial: the places of each cell's entries in serial.K
   // Only when distributed: PETSc objects need PETSc (and MPI) initialised, which a serial run never does.
   std::unique_ptr<DistributedAlgebra> parallel;
   std::unique_ptr<TangentSolver> linear;

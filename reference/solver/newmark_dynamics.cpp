@@ -20,9 +20,9 @@ void FiniteStrainSolver::Impl::build_dynamics() {
   const unsigned n = fe->n_dofs_per_cell();
   d.node_of_dof.resize(n);
   for (unsigned i = 0; i < n; ++i) d.node_of_dof[i] = fe->system_to_component_index(i).second;
-  // m_ij = ∫ ρ N_i N_j dV with the cell quadrature (degree + 1 points per direction: exact for
+  // m_ij = ∫ ρ N_i N_j dV with the mass quadrature (degree + 1 points per direction: exact for
   // N_i N_j of P1; of P2 (degree 4) QGaussSimplex(3) is exact to degree 5).
-  dealii::FEValues<3> fv(*mapping, scalar, *cell_quadrature, dealii::update_values | dealii::update_JxW_values);
+  dealii::FEValues<3> fv(*mapping, scalar, *mass_quadrature, dealii::update_values | dealii::update_JxW_values);
   d.cell_mass.resize(tria.n_active_cells());
   for (const auto& cell : tria.active_cell_iterators()) {
     fv.reinit(cell);

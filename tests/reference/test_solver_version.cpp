@@ -30,9 +30,10 @@ struct Recorded {
   double top_centre_uz;  ///< displacement of the top face's centre [m]
 };
 
-// Recorded at solver_version 1; unchanged at 2 and 3 (2 changed the cohesive interface's Newton
-// tangent, 3 the compliant grasp's layer: neither is part of this contact problem).
-constexpr int recorded_version = 3;
+// Recorded at solver_version 1; unchanged at 2, 3 and 4 (2 changed the cohesive interface's Newton
+// tangent, 3 the compliant grasp's layer, 4 the quadrature of quadratic tetrahedra: none is part
+// of this linear-element contact problem).
+constexpr int recorded_version = 4;
 constexpr Recorded recorded[] = {
     {LawKind::neo_hookean, 0.2e-3, 0.016255006743663546, 3.6468403499959687e-08, -1.7448232701213008e-05},
     {LawKind::neo_hookean, 0.4e-3, 0.1835432044673154, 3.4721048657634074e-06, -0.00019462096659265718},
@@ -42,6 +43,10 @@ constexpr Recorded recorded[] = {
 // The compliant grasp's case (below), recorded at version 3.
 constexpr double recorded_foundation_force_z = -1.6601101808386631;
 constexpr double recorded_foundation_top_uz = 0.00095331844521650069;
+
+// The same contact problem on quadratic tetrahedra (below), recorded at version 4.
+constexpr Recorded recorded_quadratic{LawKind::neo_hookean, 0.4e-3, 0.13381532556849468, 2.939563847190197e-06,
+                                      -0.00038495166623036235};
 
 constexpr double tolerance = 1e-7; // relative
 
@@ -101,6 +106,33 @@ TEST(SolverVersion, TheCompliantGraspsOutputIsTheOneRecordedForItsVersion) {
   const Recorded r{LawKind::neo_hookean, lift, 0.0, 0.0, 0.0};
   expect_unchanged("foundation force", fz, recorded_foundation_force_z, r);
   expect_unchanged("top-centre displacement", uz, recorded_foundation_top_uz, r);
+}
+
+// The sphere's indentation on quadratic tetrahedra (the element, its quadrature and the boundary
+// faces' contact search of degree 2).
+TEST(SolverVersion, TheQuadraticElementsOutputIsTheOneRecordedForItsVersion) {
+  ASSERT_EQ(solver_version, recorded_version)
+      << "solver_version was bumped: re-record the values of this test (printed below) for the new version";
+  const double L = 0.02, R = 4e-3;
+  FiniteStrainProblem p;
+  p.mesh = test::named_box(Eigen::Vector3d(-L / 2, -L / 2, 0), Eigen::Vector3d(L / 2, L / 2, L / 2), 4, 4, 2);
+  p.materials.push_back({"body", LawKind::neo_hookean, 1e5, 0.3});
+  p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::bonded, {}, {}});
+  RigidToolShape sphere;
+  sphere.radius = R;
+  p.tool = sphere;
+  SolverSettings settings;
+  settings.degree = 2;
+  FiniteStrainSolver solver(p, settings);
+  const Recorded& r = recorded_quadratic;
+  const EquilibriumReport e = solver.solve({0.0, Eigen::Vector3d(0, 0, L / 2 + R - r.depth)});
+  ASSERT_TRUE(e.converged) << e.failure;
+  const double uz = solver.displacement_at(Eigen::Vector3d(0, 0, L / 2)).z();
+  std::printf("[ recorded ] quadratic: {LawKind::neo_hookean, %.17g, %.17g, %.17g, %.17g}\n", r.depth, e.tool_force.z(),
+              e.contact_energy, uz);
+  expect_unchanged("tool force (P2)", e.tool_force.z(), r.tool_force_z, r);
+  expect_unchanged("contact energy (P2)", e.contact_energy, r.contact_energy, r);
+  expect_unchanged("top-centre displacement (P2)", uz, r.top_centre_uz, r);
 }
 
 } // namespace

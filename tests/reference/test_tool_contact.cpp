@@ -8,8 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <random>
 
 namespace kerf::reference {
 namespace {
@@ -64,6 +66,52 @@ TEST(RigidTool, WedgePushesACrackFaceToItsOwnSide) {
   EXPECT_NEAR((own.normal - std::sin(std::numbers::pi / 4.0) * Eigen::Vector3d(1, 0, -1)).norm(), 0.0, 1e-12);
   // A side does not make an outside point inside.
   EXPECT_FALSE(tool_contact(w, Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, -1e-4), Eigen::Vector3d::UnitX()).inside);
+}
+
+// The contact search's bound (rigid_tool.hpp, bounding_half_spaces): every point tool_contact
+// finds inside lies strictly inside each of the six half-spaces, and no convex combination of
+// points that outside_together rejects is inside the tool (checked against tool_contact itself,
+// the second method, on random points around a sphere and a tilted wedge).
+TEST(RigidTool, BoundingHalfSpacesHoldTheToolAndRejectOnlyOutsideHulls) {
+  RigidToolShape sphere;
+  sphere.radius = 2e-3;
+  RigidToolShape wedge;
+  wedge.kind = RigidToolShape::Kind::wedge;
+  wedge.blade.edge_direction = Eigen::Vector3d(1, 1, 0).normalized();
+  wedge.blade.cutting_direction = Eigen::Vector3d(1, -1, -2).normalized();
+  wedge.blade.wedge_angle = 0.5;
+  wedge.blade.thickness = 1.5e-3;
+  wedge.blade.edge_length = 4e-3;
+  validate(wedge);
+  const Eigen::Vector3d c(1e-3, -2e-3, 0.5e-3);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(-5e-3, 5e-3), unit(0.0, 1.0);
+  auto point = [&] { return Eigen::Vector3d(c.x() + coordinate(random), c.y() + coordinate(random), c.z() + coordinate(random)); };
+  for (const RigidToolShape& tool : {sphere, wedge}) {
+    const ToolHalfSpaces h = bounding_half_spaces(tool);
+    int inside = 0, rejected = 0;
+    for (int k = 0; k < 20000; ++k) {
+      const Eigen::Vector3d x = point();
+      if (!tool_contact(tool, c, x).inside) continue;
+      ++inside;
+      for (std::size_t f = 0; f < h.normal.size(); ++f) EXPECT_LT((x - c).dot(h.normal[f]), h.offset[f]);
+    }
+    for (int k = 0; k < 20000; ++k) {
+      // A small triangle (a boundary face's size) somewhere around the tool.
+      const Eigen::Vector3d a = point();
+      const std::array<Eigen::Vector3d, 3> t{a, a + 0.2 * (point() - c), a + 0.2 * (point() - c)};
+      if (!outside_together(h, c, t)) continue;
+      ++rejected;
+      for (int q = 0; q < 10; ++q) {
+        double l1 = unit(random), l2 = unit(random);
+        if (l1 + l2 > 1.0) l1 = 1.0 - l1, l2 = 1.0 - l2;
+        EXPECT_FALSE(tool_contact(tool, c, (1.0 - l1 - l2) * t[0] + l1 * t[1] + l2 * t[2]).inside);
+      }
+    }
+    // Both checks saw cases (the sampling box holds the tool and much around it).
+    EXPECT_GT(inside, 50);
+    EXPECT_GT(rejected, 1000);
+  }
 }
 
 TEST(ToolContact, ContactResultantBalancesTheSupportReaction) {
