@@ -111,7 +111,7 @@ void cook(benchmark::State& state) {
   state.counters["newton_its"] = its / static_cast<double>(state.iterations());
   state.counters["peak_rss_MB"] = peak_rss_mb();
 }
-BENCHMARK(cook)->Arg(11)->Arg(21)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->Iterations(1);
+BENCHMARK(cook)->Arg(4)->Arg(8)->Arg(11)->Arg(12)->Arg(21)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime()->Iterations(1);
 
 // potato_rect_cut's deformation phase at the scene's default mesh (2 mm, P1): the samples
 // t = 0, 0.25, … 2.5 s (blade from 1 mm above the top face to 1.5 mm deep, the scene's rupture
