@@ -48,6 +48,7 @@ for t in "${targets[@]}"; do
     budget=$((seconds - $(spent_on "$t")))
     if [ $budget -le 0 ]; then echo "fuzz_$t: campaign done ($(spent_on "$t") CPU s in $ledger)"; continue; fi
     # New inputs go to corpus/ in the build; the kept corpus and the seeds are read only.
+    started="$build/fuzz/$t.started"; touch "$started"
     "$build/fuzz/fuzz_$t" -timeout=60 -rss_limit_mb=2048 -print_final_stats=1 -seed="${KERF_FUZZ_SEED:-0}" \
       -artifact_prefix="$crashes/" "$corpus" "$kept" "$build/fuzz/seeds/$t" > "$log" 2>&1 &
     pid=$!
@@ -62,10 +63,23 @@ for t in "${targets[@]}"; do
     runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo 0)
     cov=$(grep -oE 'cov: [0-9]+' "$log" | tail -1 | grep -oE '[0-9]+' || echo "?")
     # libFuzzer exits 0 or 72 (interrupted) without a finding; a finding leaves a crash-, leak-,
-    # timeout- or oom- file (a slow-unit- file is an input slower than 10 s, under the 60 s hang
-    # limit: the large valid trajectories, not a finding).
-    if ls "$crashes"/crash-* "$crashes"/leak-* "$crashes"/timeout-* "$crashes"/oom-* > /dev/null 2>&1 ||
-       { [ $rc -ne 0 ] && [ $rc -ne 72 ] && [ $rc -ne 130 ]; }; then
+    # timeout- or oom- file written by this chunk (a slow-unit- file is an input slower than 10 s,
+    # under the 60 s hang limit: the large valid trajectories, not a finding). libFuzzer's timeout
+    # is wall-clock time, so a process stopped from outside (SIGSTOP, a suspended VM) reports the
+    # input it was on as a hang when it resumes: a timeout- input counts only if it hangs again when
+    # re-run alone; one that does not is kept under unreproduced/ and the chunk reports it.
+    new_findings=0
+    for f in $(find "$crashes" -maxdepth 1 -newer "$started" \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \)); do
+      if [[ $(basename "$f") == timeout-* ]] &&
+         timeout 120 "$build/fuzz/fuzz_$t" -timeout=60 -rss_limit_mb=2048 -runs=1 "$f" > "$f.rerun.log" 2>&1; then
+        mkdir -p "$crashes/unreproduced"; mv "$f" "$f.rerun.log" "$crashes/unreproduced/"
+        echo "fuzz_$t: a timeout that does not reproduce (the process was stopped from outside?): $crashes/unreproduced/$(basename "$f")"
+        [ $rc -eq 70 ] && rc=72 # libFuzzer's exit code for that timeout
+        continue
+      fi
+      new_findings=$((new_findings + 1))
+    done
+    if [ $new_findings -gt 0 ] || { [ $rc -ne 0 ] && [ $rc -ne 72 ] && [ $rc -ne 130 ]; }; then
       result=finding; status=1
       echo "fuzz_$t: FINDING after $used CPU s (log $log, input in $crashes/):"
       grep -E 'ERROR|runtime error|SUMMARY|what\(\)|Test unit written' "$log" | head -8 || true
