@@ -57,19 +57,24 @@ void expect_unchanged(const char* what, double now, double then, const Recorded&
       << "): now " << now << ", recorded " << then << " at version " << recorded_version;
 }
 
+// The block of side L (half as high) on its bonded base, a sphere of radius R above it.
+constexpr double L = 0.02, R = 4e-3;
+FiniteStrainProblem sphere_on_block(LawKind law) {
+  FiniteStrainProblem p;
+  p.mesh = test::named_box(Eigen::Vector3d(-L / 2, -L / 2, 0), Eigen::Vector3d(L / 2, L / 2, L / 2), 4, 4, 2);
+  p.materials.push_back({"body", law, 1e5, 0.3});
+  p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::bonded, {}, {}});
+  RigidToolShape sphere;
+  sphere.radius = R;
+  p.tool = sphere;
+  return p;
+}
+
 TEST(SolverVersion, TheReferencesOutputIsTheOneRecordedForItsVersion) {
   ASSERT_EQ(solver_version, recorded_version)
       << "solver_version was bumped: re-record the values of this test (printed below) for the new version";
-  const double L = 0.02, R = 4e-3;
   for (LawKind law : {LawKind::neo_hookean, LawKind::st_venant_kirchhoff}) {
-    FiniteStrainProblem p;
-    p.mesh = test::named_box(Eigen::Vector3d(-L / 2, -L / 2, 0), Eigen::Vector3d(L / 2, L / 2, L / 2), 4, 4, 2);
-    p.materials.push_back({"body", law, 1e5, 0.3});
-    p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::bonded, {}, {}});
-    RigidToolShape sphere;
-    sphere.radius = R;
-    p.tool = sphere;
-    FiniteStrainSolver solver(p, SolverSettings{});
+    FiniteStrainSolver solver(sphere_on_block(law), SolverSettings{});
     for (const Recorded& r : recorded) {
       if (r.law != law) continue;
       const EquilibriumReport e = solver.solve({0.0, Eigen::Vector3d(0, 0, L / 2 + R - r.depth)});
@@ -90,7 +95,7 @@ TEST(SolverVersion, TheReferencesOutputIsTheOneRecordedForItsVersion) {
 TEST(SolverVersion, TheCompliantGraspsOutputIsTheOneRecordedForItsVersion) {
   ASSERT_EQ(solver_version, recorded_version)
       << "solver_version was bumped: re-record the values of this test (printed below) for the new version";
-  const double L = 0.02, a = 6e-3, k = 1e8, lift = 1e-3;
+  const double a = 6e-3, k = 1e8, lift = 1e-3;
   FiniteStrainProblem p;
   p.mesh = test::named_box(Eigen::Vector3d(-L / 2, -L / 2, 0), Eigen::Vector3d(L / 2, L / 2, L / 2), 4, 4, 2);
   p.materials.push_back({"body", LawKind::neo_hookean, 1e5, 0.3});
@@ -113,17 +118,9 @@ TEST(SolverVersion, TheCompliantGraspsOutputIsTheOneRecordedForItsVersion) {
 TEST(SolverVersion, TheQuadraticElementsOutputIsTheOneRecordedForItsVersion) {
   ASSERT_EQ(solver_version, recorded_version)
       << "solver_version was bumped: re-record the values of this test (printed below) for the new version";
-  const double L = 0.02, R = 4e-3;
-  FiniteStrainProblem p;
-  p.mesh = test::named_box(Eigen::Vector3d(-L / 2, -L / 2, 0), Eigen::Vector3d(L / 2, L / 2, L / 2), 4, 4, 2);
-  p.materials.push_back({"body", LawKind::neo_hookean, 1e5, 0.3});
-  p.displacement_boundaries.push_back({"zmin", DisplacementBoundary::Kind::bonded, {}, {}});
-  RigidToolShape sphere;
-  sphere.radius = R;
-  p.tool = sphere;
   SolverSettings settings;
   settings.degree = 2;
-  FiniteStrainSolver solver(p, settings);
+  FiniteStrainSolver solver(sphere_on_block(LawKind::neo_hookean), settings);
   const Recorded& r = recorded_quadratic;
   const EquilibriumReport e = solver.solve({0.0, Eigen::Vector3d(0, 0, L / 2 + R - r.depth)});
   ASSERT_TRUE(e.converged) << e.failure;
