@@ -1,6 +1,6 @@
 #include "fuzz/fuzz_targets.hpp"
 
-#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/model_description.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "fuzz/fuzz_input_file.hpp"
 

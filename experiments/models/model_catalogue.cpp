@@ -6,9 +6,9 @@ namespace kerf {
 
 namespace {
 
-/// One model: what `kerf models` prints, how a scene is checked for it, how it is built.
+/// How a model (model_description.cpp: what it is) is checked against a scene and built.
 struct CatalogueEntry {
-  ModelDescription description;
+  std::string_view name;
   void (*require_inputs)(const Scene&);
   BuiltModel (*build)(const Scene&, const TetMesh&);
   /// For a model that takes options (then `build` may be null).
@@ -29,37 +29,15 @@ PhenomenonSet springs_represent(const Scene& scene) {
 }
 
 const CatalogueEntry catalogue[] = {
-    {{"fracture", "energy-based sharp cutting: deformation, rupture, cutting (f = J_c l), layers, pre-sliding friction",
-      "paper 001 §4, §6, Fig. 11",
-      PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction, Phenomenon::layers},
-      "one blade"},
-     &require_fracture_inputs, &build_fracture_model},
-    {{"edge", "discretised blade edge: stiffness x disparity per point, shear-limited cutting resistance, friction, drag; voxel collision; geometric cut off the servo thread; with a stylus, the cut piece pulled by the spring network",
-      "paper 000 §3.1-3.3 (with a stylus §4 and §2.1)",
-      PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction, Phenomenon::layers},
-      "one blade, or one blade then one sphere (stylus)"},
-     &require_edge_inputs, &build_edge_model},
-    {{"voxel", "polygon surface + local voxel grid: surface points advanced past critical forces, DCS, clip friction (Eq. 1)",
-      "paper 002 §2.3-2.4, Table 1",
-      PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction},
-      "one sphere (cutting stick)"},
-     &require_voxel_inputs, &build_voxel_model},
-    {{"springs", "cubic 28-spring network around the stylus(es), E and ν identified, embedding, tearing; --integrator explicit|implicit|static; "
-                 "on a one-blade cutting scene the deformation phase only (the edge presses the network: no cut, no friction)",
-      "paper 000 §2.1, §2.2", PhenomenonSet{Phenomenon::deformation, Phenomenon::tearing, Phenomenon::cutting, Phenomenon::friction},
-      "one or two spheres (styluses), or one blade (deformation phase)"},
-     &require_springs_inputs, nullptr, &build_springs_model, &springs_represent},
+    {"fracture", &require_fracture_inputs, &build_fracture_model},
+    {"edge", &require_edge_inputs, &build_edge_model},
+    {"voxel", &require_voxel_inputs, &build_voxel_model},
+    {"springs", &require_springs_inputs, nullptr, &build_springs_model, &springs_represent},
 };
-
-const std::vector<ModelDescription> descriptions = [] {
-  std::vector<ModelDescription> d;
-  for (const CatalogueEntry& e : catalogue) d.push_back(e.description);
-  return d;
-}();
 
 const CatalogueEntry* find_entry(std::string_view name) {
   for (const CatalogueEntry& e : catalogue)
-    if (e.description.name == name) return &e;
+    if (e.name == name) return &e;
   return nullptr;
 }
 
@@ -78,21 +56,15 @@ ToughnessRegions toughness_regions(const Scene& scene) {
   return r;
 }
 
-std::span<const ModelDescription> model_catalogue() { return descriptions; }
-
-const ModelDescription* find_model(std::string_view name) {
-  const CatalogueEntry* e = find_entry(name);
-  return e ? &e->description : nullptr;
-}
-
 const ModelDescription& require_model_for_scene(std::string_view name, const Scene& scene) {
   const CatalogueEntry* entry = find_entry(name);
-  if (!entry) {
+  const ModelDescription* description = find_model(name);
+  if (!entry || !description) {
     std::string known;
-    for (const CatalogueEntry& e : catalogue) known += (known.empty() ? "" : ", ") + std::string(e.description.name);
+    for (const ModelDescription& m : model_catalogue()) known += (known.empty() ? "" : ", ") + std::string(m.name);
     throw std::invalid_argument("unknown model \"" + std::string(name) + "\" (known: " + known + ")");
   }
-  const ModelDescription& d = entry->description;
+  const ModelDescription& d = *description;
   const PhenomenonSet missing = scene.phenomena.missing_from(d.covers);
   if (!missing.empty())
     throw ModelMismatch("model " + std::string(name) + " cannot represent " + missing.to_string() + ", which scene " +

@@ -1,6 +1,8 @@
 #pragma once
-// The models kerf can run, what each covers, and how each is built from a scene.
+// How each model kerf can run (model_description.hpp: what each is and covers) is checked against
+// a scene and built from it.
 
+#include "experiments/models/model_description.hpp"
 #include "experiments/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "meshes/vtu_writer.hpp"
@@ -18,19 +20,6 @@
 #include <string_view>
 
 namespace kerf {
-
-/// One entry of `kerf models`.
-struct ModelDescription {
-  std::string_view name;     ///< command-line name
-  std::string_view summary;  ///< one line
-  std::string_view source;   ///< paper and section
-  PhenomenonSet covers;      ///< phenomena it can represent
-  std::string_view tools;    ///< which tools it takes
-};
-
-/// Every model that exists in this build (a model that is not built is not listed).
-std::span<const ModelDescription> model_catalogue();
-const ModelDescription* find_model(std::string_view name);
 
 /// A model that cannot represent a scene: the message says what is missing.
 class ModelMismatch : public std::runtime_error {

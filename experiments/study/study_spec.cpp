@@ -1,7 +1,7 @@
 #include "experiments/study/study_spec.hpp"
 
 #include "experiments/calibration/free_parameters.hpp"
-#include "experiments/models/model_catalogue.hpp"
+#include "experiments/models/model_description.hpp"
 #include "experiments/study/model_resolution.hpp"
 #include "experiments/scene/toml_keys.hpp"
 

@@ -9,7 +9,6 @@
 #include "experiments/study/model_recommendation.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "experiments/trajectory/trajectory.hpp"
-#include "fuzz/catalogue_model_names.hpp"
 #include "fuzz/fuzz_targets.hpp"
 #include "realtime/haptics/replay_device.hpp"
 #include "realtime/haptics/session_file.hpp"
@@ -356,13 +355,21 @@ TEST(FuzzRegressions, ReplayNeverGivesANonFinitePosition) {
   EXPECT_NEAR((replay.state().position - Eigen::Vector3d(0.001, 0.002, 0.003)).norm(), 0.0, 1e-15);
 }
 
-TEST(FuzzHarnesses, TheFuzzBuildsModelNamesAreTheCatalogues) {
-  // The fuzz build checks a study's models against fuzz/catalogue_model_names.hpp instead of the
-  // catalogue (which links every model builder): the two lists must be the same.
-  std::vector<std::string_view> names;
-  for (const ModelDescription& d : model_catalogue()) names.push_back(d.name);
-  EXPECT_TRUE(std::equal(names.begin(), names.end(), fuzz::catalogue_model_names.begin(),
-                         fuzz::catalogue_model_names.end()));
+TEST(FuzzHarnesses, EveryModelTheStudyReaderAcceptsHasABuilder) {
+  // The study reader (and the fuzz build) accepts the names of model_description.cpp; each must be
+  // one the catalogue can check and build: asked for a scene, it answers with the scene's fit
+  // (ModelMismatch or nothing), never with "unknown model".
+  const Scene scene = read_scene(std::filesystem::path(KERF_SCENES_DIR) / "potato_rect_cut.toml");
+  ASSERT_FALSE(model_catalogue().empty());
+  for (const ModelDescription& d : model_catalogue()) {
+    try {
+      EXPECT_EQ(require_model_for_scene(d.name, scene).name, d.name);
+    } catch (const ModelMismatch&) {
+    } catch (const std::invalid_argument& e) {
+      ADD_FAILURE() << d.name << ": " << e.what();
+    }
+  }
+  EXPECT_THROW(require_model_for_scene("no-such-model", scene), std::invalid_argument);
 }
 
 TEST(FuzzHarnesses, ParameterFilesWrittenByCalibrateReadBackThroughTheHarness) {
