@@ -6,10 +6,7 @@
 //
 //   ./build/experiments/benchmarks/bench_fracture_step
 
-#include "experiments/models/model_catalogue.hpp"
-#include "experiments/models/run_model.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "experiments/benchmarks/model_on_scene.hpp"
 #include "realtime/fracture/contact_length.hpp"
 
 #include <benchmark/benchmark.h>
@@ -18,37 +15,10 @@ using namespace kerf;
 
 namespace {
 
-struct Fixture {
-  Scene scene;
-  TetMesh mesh;
-  BuiltModel model;
-  std::vector<ToolState> samples;
-};
-
-Fixture make_fixture(const std::string& name, double element_size) {
-  Fixture f;
-  f.scene = read_scene(std::filesystem::path(KERF_SOURCE_DIR) / "experiments/scenes" / (name + ".toml"));
-  if (element_size > 0.0) f.scene.geometry.element_size = element_size;
-  f.mesh = scene_mesh(f.scene);
-  f.model = make_model("fracture", f.scene, f.mesh);
-  f.samples = sample(f.scene.tools.front().trajectory).samples;
-  return f;
-}
-
 void step_along_trajectory(benchmark::State& state, const std::string& scene) {
-  Fixture f = make_fixture(scene, static_cast<double>(state.range(0)) * 1e-6);
-  ForceSample out;
-  std::size_t k = 0;
-  for (auto _ : state) {
-    if (k == f.samples.size()) {
-      k = 0;
-      f.model.model->reset();
-    }
-    f.model.model->step({&f.samples[k++], 1}, 1e-3, {&out, 1});
-    benchmark::DoNotOptimize(out);
-  }
+  bench::ModelOnScene f = bench::model_on_scene("fracture", scene, static_cast<double>(state.range(0)) * 1e-6); // µm
+  bench::step_along_trajectory(state, f);
   state.counters["tets"] = static_cast<double>(f.mesh.tets.rows());
-  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 void BM_FractureStep_PotatoWedge(benchmark::State& state) { step_along_trajectory(state, "potato_wedge_cut"); }
@@ -56,7 +26,7 @@ void BM_FractureStep_PotatoRect(benchmark::State& state) { step_along_trajectory
 
 /// The contact-length query alone, with the edge 6 mm below the wedge's apex.
 void BM_ContactLength_PotatoWedge(benchmark::State& state) {
-  Fixture f = make_fixture("potato_wedge_cut", static_cast<double>(state.range(0)) * 1e-6);
+  bench::ModelOnScene f = bench::model_on_scene("fracture", "potato_wedge_cut", static_cast<double>(state.range(0)) * 1e-6);
   SegmentLengthInBody length(f.mesh);
   const BladeShape& blade = f.scene.tools.front().blade;
   const Eigen::Vector3d mid(0.025, 0.0, 0.011), half = 0.5 * blade.edge_length * blade.edge_direction;

@@ -8,10 +8,7 @@
 //
 //   ./build/experiments/benchmarks/bench_voxel_step
 
-#include "experiments/models/model_catalogue.hpp"
-#include "experiments/models/run_model.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "experiments/benchmarks/model_on_scene.hpp"
 #include "meshes/surface_mesh.hpp"
 #include "realtime/voxel/local_voxel_grid.hpp"
 
@@ -21,37 +18,10 @@ using namespace kerf;
 
 namespace {
 
-struct Fixture {
-  Scene scene;
-  TetMesh mesh;
-  BuiltModel model;
-  std::vector<ToolState> samples;
-};
-
-Fixture make_fixture(const std::string& name, double element_size) {
-  Fixture f;
-  f.scene = read_scene(std::filesystem::path(KERF_SOURCE_DIR) / "experiments/scenes" / (name + ".toml"));
-  if (element_size > 0.0) f.scene.geometry.element_size = element_size;
-  f.mesh = scene_mesh(f.scene);
-  f.model = make_model("voxel", f.scene, f.mesh);
-  f.samples = sample(f.scene.tools.front().trajectory).samples;
-  return f;
-}
-
 void step_along_trajectory(benchmark::State& state, const std::string& scene) {
-  Fixture f = make_fixture(scene, static_cast<double>(state.range(0)) * 1e-6);
-  ForceSample out;
-  std::size_t k = 0;
-  for (auto _ : state) {
-    if (k == f.samples.size()) {
-      k = 0;
-      f.model.model->reset();
-    }
-    f.model.model->step({&f.samples[k++], 1}, 1e-3, {&out, 1});
-    benchmark::DoNotOptimize(out);
-  }
+  bench::ModelOnScene f = bench::model_on_scene("voxel", scene, static_cast<double>(state.range(0)) * 1e-6); // µm
+  bench::step_along_trajectory(state, f);
   state.counters["surface_triangles"] = static_cast<double>(boundary_surface(f.mesh).triangles.rows());
-  state.counters["steps_per_s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 void BM_VoxelStep_SpongeConstant(benchmark::State& state) { step_along_trajectory(state, "sponge_cut_constant"); }
@@ -59,7 +29,7 @@ void BM_VoxelStep_SpongeProportional(benchmark::State& state) { step_along_traje
 
 /// Placing the 10 x 20 x 20 grid on the sponge's top face (the ray cast of all 400 columns).
 void BM_VoxelGridPlacement_Sponge(benchmark::State& state) {
-  Fixture f = make_fixture("sponge_cut_constant", static_cast<double>(state.range(0)) * 1e-6);
+  bench::ModelOnScene f = bench::model_on_scene("voxel", "sponge_cut_constant", static_cast<double>(state.range(0)) * 1e-6);
   const SurfaceMesh surface = boundary_surface(f.mesh);
   std::vector<Eigen::AlignedBox3d> boxes(static_cast<std::size_t>(surface.triangles.rows()));
   for (Eigen::Index t = 0; t < surface.triangles.rows(); ++t)

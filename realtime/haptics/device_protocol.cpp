@@ -127,10 +127,13 @@ SequenceFilter::Verdict SequenceFilter::admit(std::uint32_t sequence, std::uint6
   return Verdict::accept;
 }
 
-bool receive_device_state(std::span<const std::byte> datagram, SequenceFilter& filter, LinkCounters& counters,
-                          DeviceStatePacket& out) noexcept {
+namespace {
+
+/// Decode, count and filter one datagram of either direction (the two receive functions below).
+template <class Packet>
+bool receive(std::span<const std::byte> datagram, SequenceFilter& filter, LinkCounters& counters, Packet& out) noexcept {
   ++counters.received;
-  DeviceStatePacket p;
+  Packet p;
   if (const DecodeError e = decode(datagram, p); e != DecodeError::none) {
     count_error(e, counters);
     return false;
@@ -140,17 +143,16 @@ bool receive_device_state(std::span<const std::byte> datagram, SequenceFilter& f
   return true;
 }
 
+} // namespace
+
+bool receive_device_state(std::span<const std::byte> datagram, SequenceFilter& filter, LinkCounters& counters,
+                          DeviceStatePacket& out) noexcept {
+  return receive(datagram, filter, counters, out);
+}
+
 bool receive_force_command(std::span<const std::byte> datagram, SequenceFilter& filter, LinkCounters& counters,
                            ForceCommandPacket& out) noexcept {
-  ++counters.received;
-  ForceCommandPacket p;
-  if (const DecodeError e = decode(datagram, p); e != DecodeError::none) {
-    count_error(e, counters);
-    return false;
-  }
-  if (filter.admit(p.sequence, p.timestamp_ns, counters) != SequenceFilter::Verdict::accept) return false;
-  out = p;
-  return true;
+  return receive(datagram, filter, counters, out);
 }
 
 } // namespace kerf
