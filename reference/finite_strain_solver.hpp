@@ -162,7 +162,7 @@ struct SolverSettings {
   /// pattern predicts at most this many entries in the Cholesky factor (8 bytes each; UMFPACK's
   /// LU, which takes an indefinite tangent, needs several times that), else iterative; 0: never.
   double direct_factor_limit = 1e8;
-  double relative_tolerance = 1e-9;     ///< Newton: |R_free| <= rel × F + abs, F the largest |f_int| + |f_ext| of the iteration's states
+  double relative_tolerance = 1e-9;     ///< Newton: |R_free| <= rel × (|f_int| + |f_ext|) + abs (newton_raphson.cpp: or a stall within 10× that)
   double absolute_tolerance = 1e-12;    ///< [N]
   int max_newton_iterations = 25;
   LineSearch line_search = LineSearch::residual_norm;

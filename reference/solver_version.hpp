@@ -17,8 +17,8 @@ namespace kerf::reference {
 //    changes the load path of cohesive problems.
 // 3: a grasped disc's elastic layer tapers to zero at its rim (ElasticFoundation::tapered_disc).
 // 4: quadratic tetrahedra integrate their stresses and tangent with Witherden and Vincent's
-//    8-point rule (degree 3) instead of the 14-point one (degree 5); Newton's tolerance is taken
-//    on the largest force of the iteration's states.
+//    8-point rule (degree 3) instead of the 14-point one (degree 5); Newton accepts a stall of
+//    |R| within ten times its tolerance.
 inline constexpr int solver_version = 4;
 
 } // namespace kerf::reference
