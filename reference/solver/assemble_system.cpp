@@ -17,11 +17,11 @@
 #include <deal.II/lac/full_matrix.h>
 
 #include <array>
+#include <cmath>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <type_traits>
-#include <cmath>
-#include <limits>
 
 namespace kerf::reference {
 
@@ -114,11 +114,12 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
   if (geo.nodes != 4 && geo.nodes != 10)
     throw FiniteStrainError("finite strain: " + std::to_string(geo.nodes) + " nodes per cell, expected 4 or 10 (linear or quadratic tetrahedra)");
   std::vector<double> velocity(n);
-  // The serial matrix: each cell's entries added at their places (cell_matrix_scatter.hpp).
+  // The serial matrix: each cell's entries added at their places (cell_matrix_scatter.hpp, built
+  // with the serial pattern); the distributed one through deal.II's distribute_local_to_global.
   constexpr bool serial_matrix = std::is_same_v<MatrixType, dealii::SparseMatrix<double>>;
   double* K_values = nullptr;
   if constexpr (serial_matrix)
-    if (with_matrix && !cell_scatter.empty()) K_values = CellMatrixScatter::values(K);
+    if (with_matrix) K_values = CellMatrixScatter::values(K);
   // The contact search's bound: a cell whose deformed shape lies outside one of the tool's
   // bounding half-spaces (rigid_tool.hpp) has no boundary point inside the tool, so its faces are
   // not searched. The deformed cell x(ξ) = Σ_a x_a N_a(ξ) (affine reference cell, P1 or P2
@@ -274,14 +275,10 @@ void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const Loa
     f_ext.add(local, cell_ext);
     if (with_matrix) {
       for (unsigned i = 0; i < n; ++i) cell_rhs(i) = cell_ext(i) - cell_int(i);
-      if constexpr (serial_matrix) {
-        if (K_values != nullptr)
-          cell_scatter.add(c_index, cell_K, cell_rhs, local, *constraints, K_values, *rhs);
-        else
-          constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
-      } else {
+      if constexpr (serial_matrix)
+        cell_scatter.add(c_index, cell_K, cell_rhs, local, *constraints, K_values, *rhs);
+      else
         constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
-      }
     }
   }
   if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);

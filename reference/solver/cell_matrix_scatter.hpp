@@ -67,7 +67,6 @@ public:
       }
     }
   }
-  [[nodiscard]] bool empty() const { return m_position.empty(); }
 
   /// The start of K's value array, in the order of its sparsity pattern's entries: the first
   /// row's diagonal, which a square pattern stores first in its row (checked on the last row).

@@ -1,8 +1,9 @@
 // Newton–Raphson for one load (step-44's solve_nonlinear_timestep): K du = −R with the Dirichlet
 // increment imposed through the constraints, a backtracking line search on the free residual,
 // limited-memory BFGS steps between tangents (Matthies & Strang 1979) where they are allowed, the
-// convergence test |R_free| <= rel (|f_int| + |f_ext|) + abs (or a stall within ten times it), and after convergence the support
-// reactions and the commit of the cohesive interface and the Newmark state.
+// convergence test |R_free| <= rel (|f_int| + |f_ext|) + abs (or a stall within ten times it),
+// and after convergence the support reactions and the commit of the cohesive interface and the
+// Newmark state.
 
 #include "reference/solver/finite_strain_impl.hpp"
 
