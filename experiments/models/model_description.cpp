@@ -16,7 +16,7 @@ const ModelDescription descriptions[] = {
     {"voxel", "polygon surface + local voxel grid: surface points advanced past critical forces, DCS, clip friction (Eq. 1)",
       "paper 002 §2.3-2.4, Table 1",
       PhenomenonSet{Phenomenon::deformation, Phenomenon::cutting, Phenomenon::friction},
-      "one sphere (cutting stick)"},
+      "one sphere (cutting stick), or one blade (a knife: the stick at its point)"},
     {"springs", "cubic 28-spring network around the stylus(es), E and ν identified, embedding, tearing; --integrator explicit|implicit|static; "
                  "on a one-blade cutting scene the deformation phase only (the edge presses the network: no cut, no friction)",
       "paper 000 §2.1, §2.2", PhenomenonSet{Phenomenon::deformation, Phenomenon::tearing, Phenomenon::cutting, Phenomenon::friction},

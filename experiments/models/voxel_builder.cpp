@@ -1,6 +1,6 @@
-// The voxel/polygon model (paper 002) built from a scene: one sphere tool (the cutting stick),
-// the body's boundary surface as its polygon, and Table 1 of [models.voxel] read as documented
-// in docs/models.md (section voxel).
+// The voxel/polygon model (paper 002) built from a scene: one tool (a sphere: the cutting stick;
+// a blade: a knife, whose point the stick renders), the body's boundary surface as its polygon,
+// and Table 1 of [models.voxel] read as documented in docs/models.md (section voxel).
 
 #include "experiments/models/model_builders.hpp"
 #include "meshes/surface_mesh.hpp"
@@ -17,15 +17,28 @@ namespace {
 /// stick in the 1 mm cube) [m].
 constexpr double paper_002_length_unit = 1e-3;
 
+/// Paper 002 renders a knife cut with the tip of a cutting stick (§2.2–2.3) and accounts for the
+/// buried knife edge by the depth cutting stiffness and the clip friction force (§2.4), with Cw
+/// "half of cutting edge width". A blade becomes that stick: radius Cw = t/2 (the blade's thickness
+/// t), placed at the knife's point — the lower end of the edge (z up in every scene; the edge's
+/// midpoint when the edge is level) — one radius behind it along the cutting direction d, so that
+/// the stick's leading point is the knife's point and its depth the edge's depth. Returns the
+/// stick's centre relative to the blade's reference point (its edge midpoint) [m].
+Eigen::Vector3d knife_point_stick_offset(const BladeShape& b) {
+  const Eigen::Vector3d& e = b.edge_direction;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  if (e.z() > 1e-12) point = -0.5 * b.edge_length * e;
+  else if (e.z() < -1e-12) point = 0.5 * b.edge_length * e;
+  return point - 0.5 * b.thickness * b.cutting_direction;
+}
+
 } // namespace
 
 void require_voxel_inputs(const Scene& scene) {
-  if (scene.tools.size() != 1 || scene.tools.front().kind != Tool::Kind::sphere)
-    throw ModelMismatch("model voxel renders the tip of one cutting stick (paper 002 §2.2, a sphere tool); scene " +
-                        scene.name + " has " + std::to_string(scene.tools.size()) + " tool(s)" +
-                        (!scene.tools.empty() && scene.tools.front().kind == Tool::Kind::blade
-                             ? ", a blade: a knife edge is outside paper 002's point-cutting model"
-                             : ""));
+  if (scene.tools.size() != 1)
+    throw ModelMismatch("model voxel renders one cutting stick (paper 002 §2.2: a sphere tool, or a blade whose point the "
+                        "stick renders, §2.4); scene " + scene.name + " has " + std::to_string(scene.tools.size()) +
+                        " tools");
   if (!scene.voxel)
     throw ModelMismatch("model voxel needs the [models.voxel] section (paper 002 Table 1: elastic, friction and "
                         "damping coefficients, critical forces, advance length) in " + scene.file.string());
@@ -37,8 +50,14 @@ BuiltModel build_voxel_model(const Scene& scene, const TetMesh& mesh) {
   // deformed area Cw dz), the stick's contact stiffness k_e = E x 1 mm = 20 N/mm (the paper's
   // "material stiffness" E of the DCS), damping 0.5 N s/mm^2 x 1 mm = 0.5 N s/mm.
   const double modulus = t1.elastic_coefficient / (paper_002_length_unit * paper_002_length_unit);
+  const Tool& tool = scene.tools.front();
   VoxelCuttingSetup setup;
-  setup.tool_radius = scene.tools.front().radius;
+  if (tool.kind == Tool::Kind::sphere) {
+    setup.tool_radius = tool.radius;
+  } else {
+    setup.tool_radius = 0.5 * tool.blade.thickness; // Cw of Eq. (1)
+    setup.centre_offset = knife_point_stick_offset(tool.blade);
+  }
   setup.contact_stiffness = modulus * paper_002_length_unit;
   setup.damping = t1.damping_coefficient / paper_002_length_unit;
   setup.friction_coefficient = t1.friction_coefficient;
@@ -53,7 +72,9 @@ BuiltModel build_voxel_model(const Scene& scene, const TetMesh& mesh) {
 
   nlohmann::json p;
   p["table_1_length_unit_m"] = paper_002_length_unit;
+  p["tool"] = tool.kind == Tool::Kind::sphere ? "sphere: the cutting stick" : "blade: the stick at the knife's point";
   p["tool_radius_m"] = setup.tool_radius;
+  p["stick_centre_offset_m"] = {setup.centre_offset.x(), setup.centre_offset.y(), setup.centre_offset.z()};
   p["contact_stiffness_N_per_m"] = setup.contact_stiffness;
   p["damping_N_s_per_m"] = setup.damping;
   p["friction"] = setup.friction;

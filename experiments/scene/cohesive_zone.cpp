@@ -16,6 +16,13 @@ double blade_reach(const Tool& blade) {
   return reach;
 }
 
+double blade_lowest_edge_point(const Tool& blade) {
+  const double half_rise = 0.5 * blade.blade.edge_length * std::abs(blade.blade.edge_direction.z());
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const ToolState& st : sample(blade.trajectory).samples) lowest = std::min(lowest, st.position.z() - half_rise);
+  return lowest;
+}
+
 CohesiveZone scene_cohesive_zone(const Scene& scene) {
   CohesiveZone z;
   const Material& m = scene.material;

@@ -23,6 +23,10 @@ struct CohesiveZone {
 /// max_k p_k · c [m] (p_k the edge midpoint's sampled positions).
 double blade_reach(const Tool& blade);
 
+/// The lowest height the edge of `blade` reaches over its trajectory, min_k (p_k,z − (L/2)|e_z|) [m]
+/// (p_k the edge midpoint's sampled positions, L the edge length, e its direction; z up).
+double blade_lowest_edge_point(const Tool& blade);
+
 /// The zone of `scene`'s cohesive law and blade; both 0 when the scene gives no σ_c or J_c.
 CohesiveZone scene_cohesive_zone(const Scene& scene);
 

@@ -21,7 +21,9 @@ namespace {
 /// elements of min(h0, zone / 3) on its cut plane (cohesive_zone.hpp), from the
 /// top down to one zone length below the deepest point a blade's edge reaches (the whole depth for a
 /// tear), growing to the element size h at half the distance (cut_grading_distance), all scaled by
-/// `scale`. Nothing for a blade that does not cut downwards (the grading box grows from the top).
+/// `scale`. The deepest point is the lower end of the edge at the lowest sample of the trajectory
+/// (for a downward cut with a horizontal edge, the whole edge). Nothing for a blade whose cutting
+/// direction points upwards (the grading box grows from the top).
 void add_crack_path_grading(const Scene& scene, double nominal, double scale, std::map<std::string, double>& p) {
   const SceneGeometry& g = scene.geometry;
   if (g.kind != SceneGeometry::Kind::geo || !scene_has_cohesive_law(scene)) return;
@@ -34,10 +36,10 @@ void add_crack_path_grading(const Scene& scene, double nominal, double scale, st
   double refine_depth = -1.0; // < 0: the geometry's default (its whole depth)
   for (const Tool& t : scene.tools) {
     if (t.kind != Tool::Kind::blade) continue;
-    if (t.blade.cutting_direction.z() > -0.999) return; // not a downward cut: the box grading does not apply
+    if (!(t.blade.cutting_direction.z() < 0.0)) return; // not into the top face: the box grading does not apply
     const auto top = g.parameters.find("depth");
     if (top == g.parameters.end() || declared.count("depth") == 0) return;
-    const double lowest = -blade_reach(t); // the cutting direction is −z: the edge's lowest z
+    const double lowest = blade_lowest_edge_point(t);
     refine_depth = std::min(std::max(top->second - lowest + zone.length() * scale, size), top->second);
   }
   p["cut_element_size"] = size;

@@ -29,6 +29,7 @@ const VoxelCuttingSetup& checked(const VoxelCuttingSetup& s) {
   require(positive(s.advance_length), "advance length must be positive");
   require(positive(s.regularisation_speed), "regularisation speed must be positive");
   require(!s.clip_friction || positive(s.clip_modulus), "clip friction needs a positive modulus E");
+  require(s.centre_offset.allFinite(), "the stick's centre offset must be finite");
   return s;
 }
 
@@ -106,7 +107,7 @@ void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*d
   const VoxelCuttingSetup& s = m_setup;
   const double h = s.advance_length;
   const double r = s.tool_radius;
-  const Eigen::Vector3d p = tools[0].position;
+  const Eigen::Vector3d p = tools[0].position + s.centre_offset; // the stick's centre
   const Eigen::Vector3d velocity = tools[0].velocity.allFinite() ? tools[0].velocity : Eigen::Vector3d::Zero();
   out.crack_extent = m_cut_length;
   m_last_depth_force = m_last_cutting_force = 0.0;
@@ -189,6 +190,15 @@ void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*d
       m_last_cutting_force = s.contact_stiffness * delta_c;
       if (m_last_cutting_force > s.critical_force_cutting) { // the front advances one column
         m_slack = std::max(m_slack, m_grid.lower(i2, j2, tip.x(), m_vertices, m_original));
+        // A stick wider than a column (r > h: a knife's Cw, docs/models.md, voxel) also clears the
+        // columns between its tip and its leading point, which it sweeps on its way: each one
+        // whose material reaches above the tip, sampled every half column along c.
+        for (double along = 0.5 * h; along < r; along += 0.5 * h) {
+          int i3 = 0, j3 = 0;
+          if (m_grid.column_at(tip.y() + along * c_a, tip.z() + along * c_b, i3, j3) && (i3 != i || j3 != j) &&
+              (i3 != i2 || j3 != j2) && m_grid.surface_depth(i3, j3) < tip.x())
+            m_slack = std::max(m_slack, m_grid.lower(i3, j3, tip.x(), m_vertices, m_original));
+        }
         if (m_episode_cut_advances++ == 0) m_cut_start = Eigen::Vector2d(tip.y(), tip.z());
         ++m_total_cut_advances;
         advanced = true;

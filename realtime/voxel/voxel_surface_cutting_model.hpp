@@ -37,6 +37,11 @@ struct VoxelCuttingSetup {
   double regularisation_speed = 1e-5;
   /// Most polygon triangles the grid's neighbourhood may hold; more sets ForceSample::over_budget.
   int triangle_capacity = 8192;
+  /// The stick's centre relative to the tool's reference point [m]: zero when the tool is the
+  /// cutting stick itself (a sphere); for a knife, the stick sits at the knife's point (the
+  /// builder's mapping, docs/models.md, voxel, "A knife"). Tools only translate, so the offset is
+  /// fixed.
+  Eigen::Vector3d centre_offset = Eigen::Vector3d::Zero();
 };
 
 /// Paper 002's model for one cutting stick (a sphere tip of radius r):
@@ -53,7 +58,9 @@ struct VoxelCuttingSetup {
 ///   (centre + r c) inside a neighbouring column whose surface point lies above the tip is
 ///   pressed δ_c into that column's wall and feels F_c = k_e δ_c along -c; when F_c exceeds the
 ///   cutting critical force that column is eliminated down to the tip (the front advances one
-///   advance length); the critical comparisons use the elastic forces only;
+///   advance length), with the columns between the tip and the leading point when the stick is
+///   wider than a column (r > advance length, a knife's Cw); the critical comparisons use the
+///   elastic forces only;
 /// - Coulomb friction μ F_n against the tangential velocity;
 /// - while cutting, DCS F = 0.066 E d (E = k_e, d = tip depth below the first-contact tangent
 ///   plane) and CFF Fh of Eq. (1) (Cw = r, dz = d, Cl = cut length: the tip's distance in the

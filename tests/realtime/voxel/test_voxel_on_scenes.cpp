@@ -1,12 +1,13 @@
 // The voxel model (paper 002) built by the catalogue on the sponge scenes as a user runs them
 // (gmsh meshes, the scenes' trajectories and [models.voxel] = Table 1), the DCS/CFF switches of
-// the scene file, and the refusal of blade scenes. Kept beside the model's own tests (this
+// the scene file, the knife scenes' stick at the knife's point, and the refusal of other scenes. Kept beside the model's own tests (this
 // program links kerf_experiments).
 
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
 #include "experiments/scene/scene_mesh.hpp"
 #include "experiments/scene/scene_reader.hpp"
+#include "realtime/voxel/voxel_surface_cutting_model.hpp"
 
 #include <gtest/gtest.h>
 
@@ -117,15 +118,59 @@ TEST(VoxelOnScenes, DcsAndClipFrictionSwitchFromTheSceneFile) {
   std::filesystem::remove(copy);
 }
 
-TEST(VoxelOnScenes, RefusesBladeScenesAndScenesWithoutTableOne) {
+TEST(VoxelOnScenes, AKnifeIsRenderedByTheStickAtItsPoint) {
+  // sponge_knife_cut_*: a 0.1 mm knife, edge e = (3, 0, 4)/5 of 1 mm, cutting direction
+  // d = (4, 0, -3)/5. The stick (docs/models.md, voxel, "A knife"): radius Cw = t/2 = 0.05 mm,
+  // centre = the edge's lower end (midpoint - 0.5 mm e) - Cw d.
+  const Scene scene = read_scene(scene_file("sponge_knife_cut_constant"));
+  const TetMesh mesh = scene_mesh(scene);
+  BuiltModel built = make_model("voxel", scene, mesh);
+  EXPECT_DOUBLE_EQ(built.parameters["tool_radius_m"].get<double>(), 0.05e-3);
+  const Eigen::Vector3d e(0.6, 0.0, 0.8), d(0.8, 0.0, -0.6);
+  const Eigen::Vector3d expected = -0.5e-3 * e - 0.05e-3 * d;
+  const auto offset = built.parameters["stick_centre_offset_m"].get<std::vector<double>>();
+  ASSERT_EQ(offset.size(), 3u);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(offset[static_cast<std::size_t>(k)], expected[k], 1e-15);
+
+  // Stepped along the scene's trajectory, the depth d of DCS and CFF (the stick's lowest point
+  // below the top face z = 1 mm) follows the knife's point: drawn at constant depth, the midpoint
+  // at z = 0.9 mm puts the centre at 0.9 - 0.4 + 0.05 x 0.6 = 0.53 mm and the stick's lowest point
+  // at 0.48 mm, so d = 0.52 mm (the point itself is 0.5 mm deep).
+  auto& model = dynamic_cast<VoxelSurfaceCuttingModel&>(*built.model);
+  const std::vector<SampledTrajectory> trajectories = sample_scene_trajectories(scene);
+  ForceSample force;
+  int drawn = 0;
+  for (const ToolState& st : trajectories.front().samples) {
+    model.step(std::span<const ToolState>(&st, 1), 1e-3, std::span<ForceSample>(&force, 1));
+    ASSERT_TRUE(force.force.allFinite());
+    if (st.position.z() < 0.9e-3 + 1e-9 && st.position.x() > 0.5e-3 && st.position.x() < 0.8e-3) {
+      EXPECT_NEAR(model.last_depth(), 0.52e-3, 1e-9) << "t = " << st.time;
+      EXPECT_EQ(force.mode, InteractionMode::cutting) << "t = " << st.time;
+      ++drawn;
+    }
+  }
+  EXPECT_GT(drawn, 250); // 0.3 mm of the draw at 1 mm/s and 1 kHz
+  // The cut length Cl: the draw of 0.4 mm, from where the front first advanced (at the end of
+  // the plunge, within a few advance lengths) plus one advance length.
+  EXPECT_NEAR(model.cut_length(), 0.4e-3, 0.06e-3);
+}
+
+TEST(VoxelOnScenes, RefusesScenesWithoutTableOneOrWithMoreThanOneTool) {
   for (const char* name : {"potato_rect_cut", "potato_wedge_cut", "liver_prism_cut"}) {
     const Scene s = read_scene(scene_file(name));
     try {
       require_model_for_scene("voxel", s);
       ADD_FAILURE() << name << " was accepted";
     } catch (const ModelMismatch& e) {
-      EXPECT_NE(std::string(e.what()).find("sphere"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("[models.voxel]"), std::string::npos) << e.what();
     }
+  }
+  // clay_cut_apart: a blade and a stylus.
+  try {
+    require_model_for_scene("voxel", read_scene(scene_file("clay_cut_apart")));
+    ADD_FAILURE() << "clay_cut_apart was accepted";
+  } catch (const ModelMismatch& e) {
+    EXPECT_NE(std::string(e.what()).find("one cutting stick"), std::string::npos) << e.what();
   }
   // clay_pull: one sphere, but no [models.voxel] (and no cutting).
   EXPECT_THROW(require_model_for_scene("voxel", read_scene(scene_file("clay_pull"))), ModelMismatch);

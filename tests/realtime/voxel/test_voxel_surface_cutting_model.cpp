@@ -224,6 +224,31 @@ TEST(VoxelSurfaceCuttingModel, ConstantDepthCutIsFlatProportionalDepthCutGrows) 
   EXPECT_GT(p_last, 1.5 * p_first);
 }
 
+TEST(VoxelSurfaceCuttingModel, AStickWiderThanAColumnClearsItsPath) {
+  // A knife's stick (docs/models.md, voxel, "A knife"): r = Cw = 0.05 mm, 2.5 columns of 0.02 mm.
+  // Drawn at constant depth after the plunge, the columns between its tip and its leading point
+  // are cleared with the leading one, so the tip never meets uncut material beneath it: the
+  // elastic depth force stays within one critical crossing (0.3 N, plus one advance length's
+  // k_e h = 0.4 N when the column it enters was just lowered to a tip one step higher) — a
+  // column left standing would press the tip with k_e x 0.48 mm = 9.6 N.
+  VoxelCuttingSetup setup = sponge_setup();
+  setup.tool_radius = 0.05e-3;
+  VoxelSurfaceCuttingModel model(cube_surface(1 * mm, 10), setup);
+  const double top_centre = 1.0 * mm + setup.tool_radius;
+  move(model, {0.2 * mm, 0, top_centre + 0.05 * mm}, {0.2 * mm, 0, top_centre - 0.48 * mm}, 1e-3);
+  double largest = 0.0;
+  int steps = 0;
+  move(model, {0.2 * mm, 0, top_centre - 0.48 * mm}, {0.7 * mm, 0, top_centre - 0.48 * mm}, 1e-3,
+       [&](const ToolState&, const ForceSample& f) {
+         ASSERT_TRUE(f.force.allFinite());
+         largest = std::max(largest, model.last_depth_elastic_force());
+         ++steps;
+       });
+  EXPECT_GE(steps, 500);
+  EXPECT_GT(model.cut_advances(), 20); // the front did advance along the 0.5 mm draw
+  EXPECT_LE(largest, setup.critical_force_depth + setup.contact_stiffness * setup.advance_length);
+}
+
 TEST(VoxelSurfaceCuttingModel, ModesFollowTheCut) {
   VoxelSurfaceCuttingModel model(cube_surface(1 * mm, 10), sponge_setup());
   std::vector<InteractionMode> modes;
