@@ -38,6 +38,11 @@ const FreeParameter voxel_parameters[] = {
     {"voxel", "critical_force_cutting", "F_cc", "N", 1.0, "critical force in the cutting direction (paper 002 §2.3, Table 1)",
      [](const Scene& s) { return s.voxel->critical_force_cutting; },
      [](Scene& s, double v) { s.voxel->critical_force_cutting = v; }},
+    {"voxel", "damping_coefficient", "b", "N s/m^2", 1.0,
+     "damping coefficient on the penetration rate (paper 002 Table 1; at the scenes' 1 mm/s its 0.5 N s/mm is 0.5 N, "
+     "as much as the cutting forces); a scene without damping keeps none",
+     [](const Scene& s) { return s.voxel->damping_coefficient; },
+     [](Scene& s, double v) { s.voxel->damping_coefficient = v; }},
 };
 
 } // namespace

@@ -681,8 +681,8 @@ TEST(StudyRunner, TheCalibrationTrajectoryIsTheSamePathPlayedFaster) {
 
 TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
   // The study reports calibrated and uncalibrated rows side by side: the default study
-  // fits every model `kerf calibrate` supports that runs on its scenes: the springs on clay_pull
-  // and the fracture model on both potato cuts (voxel runs on none of the three scenes).
+  // fits every model `kerf calibrate` supports that runs on its scenes: the springs on clay_pull,
+  // the fracture model on both potato cuts and the voxel model on the sponge knife cut.
   const StudySpec s = read_study(fs::path(KERF_STUDIES_DIR) / "default.toml");
   ASSERT_TRUE(s.has_reference);
   std::set<std::pair<std::string, std::string>> fits;
@@ -691,16 +691,38 @@ TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
     EXPECT_NE(f.speed, 1.0); // the scene's own trajectory stays held out
   }
   EXPECT_EQ(fits, (std::set<std::pair<std::string, std::string>>{
-                      {"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}, {"potato_wedge_cut", "fracture"}}));
+                      {"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}, {"potato_wedge_cut", "fracture"},
+                      {"sponge_knife_cut_proportional", "voxel"}}));
   // Solution verification: three mesh levels for every scene (Reference III): clay_pull's finest
   // the scene's own mesh, the potato cuts' finest a crack path of 0.25 mm, half their own
   // ([reference] scene_refinements), the rectangular cut on more samples ([reference] scene_samples).
   EXPECT_EQ(s.reference.levels_of("clay_pull"), (std::vector<int>{-2, -1, 0}));
   EXPECT_EQ(s.reference.levels_of("potato_rect_cut"), (std::vector<int>{-1, 0, 1}));
   EXPECT_EQ(s.reference.levels_of("potato_wedge_cut"), (std::vector<int>{-1, 0, 1}));
+  EXPECT_EQ(s.reference.levels_of("sponge_knife_cut_proportional"), (std::vector<int>{-1, 0, 1}));
   EXPECT_GT(s.reference.samples_of("potato_rect_cut"), s.reference.samples);
   // The shipped references, beside the study files.
   EXPECT_EQ(s.reference.library, (fs::path(KERF_STUDIES_DIR) / ".." / "references").lexically_normal());
+}
+
+TEST(StudySpec, EveryFastModelOfTheDefaultStudyRunsOnOneOfItsScenes) {
+  // Studies II: the default study scores every fast model of the catalogue against the reference,
+  // so each must accept (require_model_for_scene: tools, sections, phenomena) at least one of its
+  // scenes — the voxel model the sponge knife cut, which no other default scene gives it.
+  const StudySpec s = read_study(fs::path(KERF_STUDIES_DIR) / "default.toml");
+  std::set<std::string> listed(s.models.begin(), s.models.end());
+  for (const ModelDescription& m : model_catalogue()) EXPECT_TRUE(listed.count(std::string(m.name))) << m.name;
+  for (const std::string& model : s.models) {
+    std::vector<std::string> accepted;
+    for (const fs::path& scene : s.scenes) {
+      try {
+        require_model_for_scene(model, read_scene(scene));
+        accepted.push_back(scene.stem().string());
+      } catch (const ModelMismatch&) {
+      }
+    }
+    EXPECT_FALSE(accepted.empty()) << model << " runs on none of the default study's scenes";
+  }
 }
 
 TEST(StudySpec, TheReferenceLibraryIsAFolderBesideTheStudy) {
