@@ -1,9 +1,11 @@
 #!/usr/bin/python3
 """Plots of a kerf study (docs/studies.md), from kerf's own CSV files, with matplotlib.
 
-  plot_study.py profiles OUT_STEM [LABEL=PROFILE.csv ...] [--run LABEL PROFILE.csv ...] [--axis x|y|z|-x|-y|-z]
+  plot_study.py profiles OUT_STEM [LABEL=PROFILE.csv ...] [--run LABEL PROFILE.csv ...]
+                 [--axis x|y|z|-x|-y|-z | --direction DX,DY,DZ]
                  [--reference LABEL REFERENCE.csv [--band-source TEXT]] [--time-panel] [--title TEXT]
-      the resisting force along the axis of advance against tool travel: the reference (a profile
+      the resisting force along the direction of advance (an axis, or a blade's cutting direction
+      d: -f . d) against tool travel along it ((p - p0) . d): the reference (a profile
       CSV with band_low, band_high columns [N]) in black with its uncertainty band in grey, one
       curve per fast model on top, the reference's interaction modes shaded where they occur
       (paper 001's deformation-1 / rupture / cutting / deformation-2; the legend lists those
@@ -74,15 +76,16 @@ def write_data(stem, header, rows):
     os.replace(tmp, f"{stem}.csv")
 
 
-def curves(rows, index, sign):
-    """Per tool: (tool, times [s], travel [mm], resisting force [N], modes, source rows)."""
+def curves(rows, direction):
+    """Per tool: (tool, times [s], travel [mm], resisting force [N], modes, source rows), along the
+    unit vector `direction`."""
     out = []
     for tool in sorted({r["tool"] for r in rows}):
         mine = [r for r in rows if r["tool"] == tool]
-        p0 = float(mine[0]["p" + "xyz"[index]])
-        travel = [1e3 * sign * (float(r["p" + "xyz"[index]]) - p0) for r in mine]  # mm
-        # The body pushes back against the advance: plot the resisting force, -f . axis.
-        force = [-sign * float(r["f" + "xyz"[index]]) for r in mine]
+        p0 = [float(mine[0]["p" + c]) for c in "xyz"]
+        travel = [1e3 * sum(direction[i] * (float(r["p" + "xyz"[i]]) - p0[i]) for i in range(3)) for r in mine]  # mm
+        # The body pushes back against the advance: plot the resisting force, -f . d.
+        force = [-sum(direction[i] * float(r["f" + "xyz"[i]]) for i in range(3)) for r in mine]
         out.append((tool, [float(r["t"]) for r in mine], travel, force, [r["mode"] for r in mine], mine))
     return out
 
@@ -104,11 +107,32 @@ def shade_modes(ax, xs, ys, modes):
     return drawn
 
 
-def plot_profiles(stem, runs, axis, reference=None, band_source="", time_panel=False, title=""):
+def direction_of(axis=None, direction=None):
+    """The unit direction of advance and its name for the axis label: an axis (x, -z, ...) or a
+    vector "DX,DY,DZ" (normalised; named as its axis when it is one)."""
+    if direction is None:
+        index, sign = AXES[axis]
+        return tuple(float(sign) if i == index else 0.0 for i in range(3)), axis
+    try:
+        v = [float(c) for c in direction.split(",")]
+    except ValueError:
+        v = []
+    norm = math.sqrt(sum(c * c for c in v)) if len(v) == 3 else 0.0
+    if not (norm > 0.0 and math.isfinite(norm)):
+        sys.exit(f"--direction: expected three numbers DX,DY,DZ, not all zero, got {direction!r}")
+    v = tuple(c / norm for c in v)
+    for name, (index, sign) in AXES.items():
+        if abs(v[index] - sign) < 1e-12:
+            return v, name
+    return v, "d = (" + ", ".join(f"{c:.3g}" for c in v) + ")"
+
+
+def plot_profiles(stem, runs, axis, reference=None, band_source="", time_panel=False, title="", direction=None):
     """runs: [(label, path)] of the fast models; reference: (label, path) of the finest reference,
-    its CSV a profile with band_low and band_high columns [N] (the resisting force's band)."""
-    index, sign = AXES[axis]
-    panels = [("travel", f"tool travel along {axis} [mm]")] + ([("time", "time [s]")] if time_panel else [])
+    its CSV a profile with band_low and band_high columns [N] (the resisting force's band, along
+    the same direction); `direction` ("DX,DY,DZ") replaces the axis when given."""
+    d, name_of_d = direction_of(axis, direction)
+    panels = [("travel", f"tool travel along {name_of_d} [mm]")] + ([("time", "time [s]")] if time_panel else [])
     fig, axes = plt.subplots(1, len(panels), figsize=(7 * len(panels), 4.5), squeeze=False)
     axes = {name: ax for (name, _), ax in zip(panels, axes[0])}
     data = []
@@ -117,7 +141,7 @@ def plot_profiles(stem, runs, axis, reference=None, band_source="", time_panel=F
     shaded = False
     for n, (label, path, is_reference) in enumerate(series):
         rows = read_profile(path)
-        tools = curves(rows, index, sign)
+        tools = curves(rows, d)
         for tool, times, travel, force, modes, source in tools:
             name = label if len(tools) == 1 else f"{label} ({tool})"
             low = high = None
@@ -305,6 +329,7 @@ def main(argv):
     p.add_argument("stem")
     p.add_argument("runs", nargs="*", help="LABEL=PROFILE.csv")
     p.add_argument("--axis", default="-z", choices=list(AXES))
+    p.add_argument("--direction", help="the direction of advance DX,DY,DZ (e.g. a blade's cutting direction); replaces --axis")
     p.add_argument("--run", nargs=2, action="append", default=[], metavar=("LABEL", "PROFILE"),
                    help="a fast model's profile (a label may hold '=')")
     p.add_argument("--reference", nargs=2, metavar=("LABEL", "REFERENCE"),
@@ -341,7 +366,7 @@ def main(argv):
             runs.append((label, path))
         runs += [tuple(r) for r in args.run]
         reference = tuple(args.reference) if args.reference else None
-        plot_profiles(args.stem, runs, args.axis, reference, args.band_source, args.time_panel, args.title)
+        plot_profiles(args.stem, runs, args.axis, reference, args.band_source, args.time_panel, args.title, args.direction)
     else:
         plot_pareto(args.stem, args.table, args.error, args.cost, args.label, args.scene, args.floor, args.title)
 

@@ -34,9 +34,11 @@ void run_plot_script(const std::vector<std::string>& args) {
 } // namespace
 
 void plot_profiles(const std::filesystem::path& stem, const std::vector<std::pair<std::string, std::filesystem::path>>& runs,
-                   const std::string& axis, const std::optional<ProfilePlotReference>& reference, bool time_panel,
+                   const Eigen::Vector3d& direction, const std::optional<ProfilePlotReference>& reference, bool time_panel,
                    const std::string& title) {
-  std::vector<std::string> args{"profiles", stem.string(), "--axis=" + axis, "--title=" + title};
+  char d[96];
+  std::snprintf(d, sizeof d, "--direction=%.17g,%.17g,%.17g", direction.x(), direction.y(), direction.z());
+  std::vector<std::string> args{"profiles", stem.string(), d, "--title=" + title};
   for (const auto& [label, csv] : runs) args.insert(args.end(), {"--run", label, csv.string()}); // a label may hold "="
   if (reference) {
     args.insert(args.end(), {"--reference", reference->label, reference->csv.string()});
@@ -70,12 +72,6 @@ Eigen::Vector3d advance_direction(const Scene& scene) {
       from = s.target;
     }
   return Eigen::Vector3d::UnitZ();
-}
-
-std::string axis_name(const Eigen::Vector3d& direction) {
-  int axis = 0;
-  direction.cwiseAbs().maxCoeff(&axis);
-  return std::string(direction[axis] < 0 ? "-" : "") + "xyz"[axis];
 }
 
 bool holds_or_retreats(const Scene& scene) {

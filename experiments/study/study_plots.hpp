@@ -22,13 +22,14 @@ struct ProfilePlotReference {
   std::string band_source;         ///< what the band is, for the legend ("GCI band", "spread of L-1..L1")
 };
 
-/// The resisting force along the axis of advance against tool travel: the reference with its band
-/// (when given), each labelled profile on top, the reference's modes (else the first run's) shaded
-/// where they occur; with `time_panel`, force against time beside. STEM.png, STEM.pdf, and STEM.csv
-/// (panel, series, x, y, band_low, band_high: the data drawn). `axis` is one of x y z -x -y -z.
-/// Throws std::runtime_error naming the command if the plotting program fails.
+/// The resisting force along the direction of advance d (unit; advance_direction), −f·d, against
+/// tool travel along it, (p − p0)·d: the reference with its band (when given, the band of −f·d),
+/// each labelled profile on top, the reference's modes (else the first run's) shaded where they
+/// occur; with `time_panel`, force against time beside. STEM.png, STEM.pdf, and STEM.csv (panel,
+/// series, x, y, band_low, band_high: the data drawn). Throws std::runtime_error naming the command
+/// if the plotting program fails.
 void plot_profiles(const std::filesystem::path& stem, const std::vector<std::pair<std::string, std::filesystem::path>>& runs,
-                   const std::string& axis, const std::optional<ProfilePlotReference>& reference = std::nullopt,
+                   const Eigen::Vector3d& direction, const std::optional<ProfilePlotReference>& reference = std::nullopt,
                    bool time_panel = false, const std::string& title = "");
 
 /// Error against p99 cost per step (log-log) for the rows of `scene` (all rows when empty) of a
@@ -42,9 +43,6 @@ void plot_pareto(const std::filesystem::path& stem, const std::filesystem::path&
 /// The unit direction a scene's first tool advances along: a blade's cutting direction, else the
 /// direction of its first move.
 Eigen::Vector3d advance_direction(const Scene& scene);
-
-/// The coordinate axis closest to a direction, as plot_profiles takes it: "x", "-z", …
-std::string axis_name(const Eigen::Vector3d& direction);
 
 /// Whether a scene's first tool holds still or moves back against its advance at some point: then
 /// its force against travel folds onto itself and a force-time view is drawn beside.

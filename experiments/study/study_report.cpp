@@ -115,7 +115,7 @@ void write_study_report(const StudySpec& spec, const StudyResult& result, const 
     const Eigen::Vector3d direction = advance_direction(scene);
     std::optional<ProfilePlotReference> drawn;
     if (reference) drawn = write_reference_series(*reference, direction, out / (scene.name + "_reference.csv"));
-    plot_profiles(out / (scene.name + "_profiles"), runs, axis_name(direction), drawn, holds_or_retreats(scene),
+    plot_profiles(out / (scene.name + "_profiles"), runs, direction, drawn, holds_or_retreats(scene),
                   scene.name + ": resisting force of the " + scene.tools.front().name);
     if (any_error)
       plot_pareto(out / (scene.name + "_pareto"), out / "study.csv", "RMS force error [%]", "p99 cost [µs]", "model", scene.name,
