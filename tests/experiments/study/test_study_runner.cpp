@@ -181,7 +181,7 @@ TEST(StudyRunner, AModelIsScoredOnlyOverThePhasesItRepresents) {
 }
 
 TEST(StudyRunner, AModelThatCannotRunOnASceneHasARowSayingWhy) {
-  // The voxel model needs a sphere (paper 002's cutting stick); potato_rect_cut has a blade.
+  // The voxel model needs paper 002's Table 1 ([models.voxel]); potato_rect_cut gives none.
   const StudySpec spec = read_study(write_study(
       "na.toml", "[study]\nname = \"na\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\", \"voxel\"]\n"));
   const fs::path out = fs::temp_directory_path() / ("kerf_test_study_na_" + std::to_string(::getpid()));
@@ -192,7 +192,7 @@ TEST(StudyRunner, AModelThatCannotRunOnASceneHasARowSayingWhy) {
   EXPECT_FALSE(r.rows[1].metrics.has_value());
   EXPECT_EQ(r.rows[1].cost.steps, 0u);
   EXPECT_EQ(r.rows[1].note.rfind("not run: ", 0), 0u) << r.rows[1].note;
-  EXPECT_NE(r.rows[1].note.find("sphere"), std::string::npos) << r.rows[1].note;
+  EXPECT_NE(r.rows[1].note.find("[models.voxel]"), std::string::npos) << r.rows[1].note;
   EXPECT_FALSE(fs::exists(out / "potato_rect_cut" / "voxel" / "profile.csv"));
   EXPECT_EQ(r.table().row_count(), 2u);
   fs::remove_all(out);
