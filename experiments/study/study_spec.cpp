@@ -81,7 +81,10 @@ StudySpec read_study(const std::filesystem::path& file) {
     allow_only(file, *ref, "reference.", {"degree", "scene_degree", "refinements", "scene_refinements", "samples", "scene_samples", "linear_solver",
                                            "fracture", "library"});
     if (auto d = (*ref)["degree"]) {
-      const auto v = d.value<int64_t>();
+      // Integers are TOML integers, as in scene files: value_exact, never toml++'s value<int64_t>(),
+      // which casts a float (6.7e87, say) to int64_t unchecked (undefined behaviour; found by
+      // fuzz_study, fuzz/regressions/study/).
+      const auto v = d.value_exact<int64_t>();
       if (!v || (*v != 1 && *v != 2)) fail(file, d.node()->source(), "reference.degree", "expected 1 or 2");
       spec.reference.degree = static_cast<int>(*v); // else each scene's own
     }
@@ -92,7 +95,7 @@ StudySpec read_study(const std::filesystem::path& file) {
       if (!a || a->empty()) fail(file, r.node()->source(), key, "expected an array of levels in " + range);
       std::vector<int> levels;
       for (const toml::node& n : *a) {
-        const auto v = n.value<int64_t>();
+        const auto v = n.value_exact<int64_t>();
         if (!v || *v < minimum_study_mesh_level || *v > 4)
           fail(file, n.source(), key, "expected a level in " + range + " (k < 0: the scene's element size times 2^-k)");
         if (!levels.empty() && *v <= levels.back()) fail(file, n.source(), key, "expected ascending levels (the last is the finest)");
@@ -126,7 +129,7 @@ StudySpec read_study(const std::filesystem::path& file) {
         const bool known = std::any_of(spec.scenes.begin(), spec.scenes.end(),
                                        [&](const std::filesystem::path& p) { return p.stem().string() == scene; });
         if (!known) fail(file, value.source(), key, "expected a scene of study.scenes");
-        const auto v = value.value<int64_t>();
+        const auto v = value.value_exact<int64_t>();
         if (!v || *v < lo || *v > hi) fail(file, value.source(), key, "expected " + expected);
         values[scene] = static_cast<int>(*v);
       }
@@ -141,7 +144,7 @@ StudySpec read_study(const std::filesystem::path& file) {
         fail(file, l.node()->source(), "reference.library", "expected a folder, not the file " + spec.reference.library.string());
     }
     if (auto s = (*ref)["samples"]) {
-      const auto v = s.value<int64_t>();
+      const auto v = s.value_exact<int64_t>();
       if (!v || *v < 2 || *v > std::numeric_limits<int>::max())
         fail(file, s.node()->source(), "reference.samples", "expected an integer in 2..2147483647");
       spec.reference.samples = static_cast<int>(*v);
@@ -187,7 +190,7 @@ StudySpec read_study(const std::filesystem::path& file) {
       if (!a || a->empty()) fail(file, r->source(), key + ".resolutions", expected);
       std::vector<int>& values = spec.resolutions[std::string(name.str())];
       for (const toml::node& n : *a) {
-        const auto v = n.value<int64_t>();
+        const auto v = n.value_exact<int64_t>();
         if (!v || *v < range.first || *v > range.second || (!values.empty() && *v <= values.back()))
           fail(file, n.source(), key + ".resolutions", expected);
         values.push_back(static_cast<int>(*v));
@@ -240,12 +243,12 @@ StudySpec read_study(const std::filesystem::path& file) {
         fit.speed = *f;
       }
       if (auto v = t["max_evaluations"]) {
-        const auto e = v.value<int64_t>();
+        const auto e = v.value_exact<int64_t>();
         if (!e || *e < 1 || *e > 100000) fail(file, v.node()->source(), "calibrate.max_evaluations", "expected an integer in 1..100000");
         fit.max_evaluations = static_cast<int>(*e);
       }
       if (auto v = t["samples"]) {
-        const auto n = v.value<int64_t>();
+        const auto n = v.value_exact<int64_t>();
         if (!n || *n < 2 || *n > 100000) fail(file, v.node()->source(), "calibrate.samples", "expected an integer in 2..100000");
         fit.samples = static_cast<int>(*n);
       }

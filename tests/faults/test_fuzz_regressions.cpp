@@ -301,6 +301,31 @@ TEST(FuzzRegressions, StudyWithAnUnlookableSceneNameOrSamplesPastIntIsAStudyErro
   EXPECT_EQ(read_study(ok).reference.samples, 2147483647);
 }
 
+TEST(FuzzRegressions, StudyIntegerGivenAsAHugeFloatIsAStudyErrorNotUndefinedBehaviour) {
+  // Finding (fuzz_study, the campaign): samples = 6.67e87 (a float) was read with toml++'s
+  // value<int64_t>(), which casts a float to int64_t unchecked (UBSan: "6.66667e+87 is outside the
+  // range of representable values of type 'long'"). The study reader now takes integers only as
+  // TOML integers (value_exact), as the scene reader does: any float is "expected an integer".
+  const auto message = [](const fs::path& file) {
+    try {
+      read_study(file);
+    } catch (const StudyError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string huge = message(regressions / "study" / "float_samples_beyond_int64.toml");
+  EXPECT_NE(huge.find("float_samples_beyond_int64.toml:9:"), std::string::npos) << huge;
+  EXPECT_NE(huge.find("reference.samples: expected an integer in 2..2147483647"), std::string::npos) << huge;
+  // A whole float is a float too, in every integer key of a study file.
+  for (const char* line : {"[reference]\nsamples = 12.0\n", "[reference]\ndegree = 2.0\n", "[reference]\nrefinements = [0.0]\n",
+                           "[models.springs]\nresolutions = [4.0]\n"}) {
+    const fs::path file = scratch("float_integer.toml");
+    std::ofstream(file) << "[study]\nname = \"x\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n" << line;
+    EXPECT_NE(message(file).find("expected"), std::string::npos) << line;
+  }
+}
+
 TEST(FuzzRegressions, StudyTableWithANonFiniteOrNegativeMeasurementIsAnError) {
   // Found by reading model_recommendation.cpp, confirmed through fuzz_study_table: "nan" in the
   // error column (or "-inf" as a cost) read as a number, passed every budget comparison of
