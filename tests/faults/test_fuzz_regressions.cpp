@@ -56,6 +56,16 @@ std::string error_of(Read read) {
   return "";
 }
 
+/// The message of the StudyError read_study throws for `file` ("" if it reads).
+std::string study_error_of(const fs::path& file) {
+  try {
+    read_study(file);
+  } catch (const StudyError& e) {
+    return e.what();
+  }
+  return "";
+}
+
 } // namespace
 
 TEST(FuzzRegressions, EverySavedInputPassesItsHarness) {
@@ -280,18 +290,10 @@ TEST(FuzzRegressions, StudyWithAnUnlookableSceneNameOrSamplesPastIntIsAStudyErro
   // as std::filesystem::filesystem_error, which names no line; (2) samples = 4294967297 was
   // accepted and converted to int as 1 (below the documented minimum of 2). Both are now
   // StudyErrors naming file:line:column and the key.
-  const auto message = [](const fs::path& file) {
-    try {
-      read_study(file);
-    } catch (const StudyError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
-  const std::string name = message(regressions / "study" / "scene_name_too_long.toml");
+  const std::string name = study_error_of(regressions / "study" / "scene_name_too_long.toml");
   EXPECT_NE(name.find("scene_name_too_long.toml:3:"), std::string::npos) << name;
   EXPECT_NE(name.find("study.scenes: no scene"), std::string::npos) << name;
-  const std::string samples = message(regressions / "study" / "samples_past_int.toml");
+  const std::string samples = study_error_of(regressions / "study" / "samples_past_int.toml");
   EXPECT_NE(samples.find("samples_past_int.toml:6:"), std::string::npos) << samples;
   EXPECT_NE(samples.find("reference.samples: expected an integer in 2..2147483647"), std::string::npos) << samples;
   // The largest int still reads (the bound is the type's, not a smaller policy).
@@ -306,15 +308,7 @@ TEST(FuzzRegressions, StudyIntegerGivenAsAHugeFloatIsAStudyErrorNotUndefinedBeha
   // value<int64_t>(), which casts a float to int64_t unchecked (UBSan: "6.66667e+87 is outside the
   // range of representable values of type 'long'"). The study reader now takes integers only as
   // TOML integers (value_exact), as the scene reader does: any float is "expected an integer".
-  const auto message = [](const fs::path& file) {
-    try {
-      read_study(file);
-    } catch (const StudyError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
-  const std::string huge = message(regressions / "study" / "float_samples_beyond_int64.toml");
+  const std::string huge = study_error_of(regressions / "study" / "float_samples_beyond_int64.toml");
   EXPECT_NE(huge.find("float_samples_beyond_int64.toml:9:"), std::string::npos) << huge;
   EXPECT_NE(huge.find("reference.samples: expected an integer in 2..2147483647"), std::string::npos) << huge;
   // A whole float is a float too, in every integer key of a study file.
@@ -322,7 +316,7 @@ TEST(FuzzRegressions, StudyIntegerGivenAsAHugeFloatIsAStudyErrorNotUndefinedBeha
                            "[models.springs]\nresolutions = [4.0]\n"}) {
     const fs::path file = scratch("float_integer.toml");
     std::ofstream(file) << "[study]\nname = \"x\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n" << line;
-    EXPECT_NE(message(file).find("expected"), std::string::npos) << line;
+    EXPECT_NE(study_error_of(file).find("expected"), std::string::npos) << line;
   }
 }
 
