@@ -45,26 +45,20 @@ fs::path scratch(const std::string& name) {
   return dir / name;
 }
 
-/// The message of the std::runtime_error `read` throws ("" if it throws nothing).
-template <typename Read>
+/// The message of the `Error` `read` throws ("" if it throws nothing; any other exception fails
+/// the test that called it).
+template <typename Error = std::runtime_error, typename Read>
 std::string error_of(Read read) {
   try {
     read();
-  } catch (const std::runtime_error& e) {
+  } catch (const Error& e) {
     return e.what();
   }
   return "";
 }
 
 /// The message of the StudyError read_study throws for `file` ("" if it reads).
-std::string study_error_of(const fs::path& file) {
-  try {
-    read_study(file);
-  } catch (const StudyError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string study_error_of(const fs::path& file) { return error_of<StudyError>([&] { read_study(file); }); }
 
 } // namespace
 
@@ -288,7 +282,7 @@ TEST(FuzzRegressions, StudyWithAnUnlookableSceneNameOrSamplesPastIntIsAStudyErro
   // Found by reading study_spec.cpp, confirmed through fuzz_study (the 4-minute run did not reach
   // them): (1) a scene name the file system cannot look up (300 characters: ENAMETOOLONG) escaped
   // as std::filesystem::filesystem_error, which names no line; (2) samples = 4294967297 was
-  // accepted and converted to int as 1 (below the documented minimum of 2). Both are now
+  // accepted and converted to int as 1 (below the documented minimum of 2). Both are
   // StudyErrors naming file:line:column and the key.
   const std::string name = study_error_of(regressions / "study" / "scene_name_too_long.toml");
   EXPECT_NE(name.find("scene_name_too_long.toml:3:"), std::string::npos) << name;
@@ -306,7 +300,7 @@ TEST(FuzzRegressions, StudyWithAnUnlookableSceneNameOrSamplesPastIntIsAStudyErro
 TEST(FuzzRegressions, StudyIntegerGivenAsAHugeFloatIsAStudyErrorNotUndefinedBehaviour) {
   // Finding (fuzz_study, the campaign): samples = 6.67e87 (a float) was read with toml++'s
   // value<int64_t>(), which casts a float to int64_t unchecked (UBSan: "6.66667e+87 is outside the
-  // range of representable values of type 'long'"). The study reader now takes integers only as
+  // range of representable values of type 'long'"). The study reader takes integers only as
   // TOML integers (value_exact), as the scene reader does: any float is "expected an integer".
   const std::string huge = study_error_of(regressions / "study" / "float_samples_beyond_int64.toml");
   EXPECT_NE(huge.find("float_samples_beyond_int64.toml:9:"), std::string::npos) << huge;
