@@ -2,7 +2,10 @@
 // How kerf's programs (kerf, kerf-rig) end: the command line parsed, the chosen subcommand run,
 // and what it throws mapped to an exit status and one line on stderr:
 //   0 done; 1 any other error; 2 a scene or mesh error (the file and place named); 3 a model that
-//   cannot represent the scene (what is missing named); CLI11's own statuses for a bad command line.
+//   cannot represent the scene (what is missing named); 4 a reference whose load path stopped before
+//   the trajectory's end (kerf reference, or a reference a study solved or read): what it solved is
+//   written, its manifest marked `partial`, and the message names the sample it stopped at;
+//   CLI11's own statuses for a bad command line.
 
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/scene/scene_reader.hpp"
@@ -12,8 +15,24 @@
 
 #include <cstdio>
 #include <exception>
+#include <stdexcept>
+#include <string>
 
 namespace kerf::cli {
+
+/// Exit status 4 (see file comment): a reference's load path stopped; its partial results are written.
+inline constexpr int exit_reference_stopped = 4;
+
+/// A command that ran to its end and wrote what it could, whose result is nevertheless incomplete:
+/// the program ends with `status` and the message.
+class IncompleteRun : public std::runtime_error {
+public:
+  IncompleteRun(int status, const std::string& what) : std::runtime_error(what), m_status(status) {}
+  [[nodiscard]] int status() const { return m_status; }
+
+private:
+  int m_status;
+};
 
 inline int run_command_line(CLI::App& app, int argc, char** argv, const char* program) {
   try {
@@ -29,6 +48,9 @@ inline int run_command_line(CLI::App& app, int argc, char** argv, const char* pr
   } catch (const ModelMismatch& e) {
     std::fprintf(stderr, "%s: %s\n", program, e.what());
     return 3;
+  } catch (const IncompleteRun& e) {
+    std::fprintf(stderr, "%s: incomplete: %s\n", program, e.what());
+    return e.status();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: error: %s\n", program, e.what());
     return 1;

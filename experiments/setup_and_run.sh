@@ -51,7 +51,7 @@ case "$job" in
     cd "$here"
     "$build/apps/kerf/kerf" mesh potato_rect_cut
     "$build/apps/kerf/kerf" run potato_rect_cut --model fracture
-    "$build/apps/kerf/kerf" study default --results-doc docs/results.md
+    "$build/apps/kerf/kerf" study default
     ;;
   test)
     cd "$build"

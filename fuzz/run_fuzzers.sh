@@ -8,13 +8,21 @@
 #
 #   bash fuzz/run_fuzzers.sh [SECONDS_PER_TARGET [TARGET...]]    # default 30 s, every target
 #   bash fuzz/run_fuzzers.sh --campaign CPU_SECONDS [TARGET...]    # the long campaign
+#   bash fuzz/run_fuzzers.sh --minimise [TARGET...]                # re-minimise the kept corpora
 #
-# Every run also reads the kept corpus fuzz/corpus/TARGET/ (committed; read only in a short run).
+# Every run also reads the kept corpus fuzz/corpus/TARGET/ (committed; read only in a short run):
+# the smallest inputs that add coverage to the seeds (written into the build tree at build time).
 # A campaign runs each target until it has spent CPU_SECONDS of CPU time in total, counted over
 # every campaign run of that target in fuzz/campaign.tsv (so it resumes where it was stopped, and a
 # niced run on a busy machine counts only the CPU it got). Each chunk appends one line to the ledger
 # (target, CPU seconds, executions, finding or none, libFuzzer's coverage), then the kept corpus is
-# minimised with libFuzzer's -merge=1 into fuzz/corpus/TARGET/. Commit both.
+# minimised (below) with what the chunk found. Commit both.
+#
+# Minimising (after a campaign chunk, or --minimise alone): libFuzzer's -merge=1 with the seeds as
+# the corpus already held, so the kept corpus becomes the inputs that add coverage to the seeds,
+# taken smallest first, from the kept corpus and the build tree's corpus/TARGET/ (what runs in this
+# build folder found). --minimise also prints the coverage (edges, features) of the seeds and kept
+# corpus before and after.
 #
 # KERF_FUZZ_BUILD_DIR overrides the build folder (default: build-fuzz beside the sources);
 # KERF_FUZZ_SEED fixes libFuzzer's random seed (CI: 1; default 0, a new seed each run).
@@ -22,7 +30,9 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${KERF_FUZZ_BUILD_DIR:-$here/build-fuzz}"
 campaign=0
+minimise_only=0
 if [ "${1:-}" = "--campaign" ]; then campaign=1; shift; fi
+if [ "${1:-}" = "--minimise" ]; then minimise_only=1; shift; set -- 0 "$@"; fi
 seconds="${1:-30}"
 shift || true
 targets=("$@")
@@ -37,6 +47,28 @@ ledger="$here/fuzz/campaign.tsv"
 cpu_seconds_of() { awk -v hz="$(getconf CLK_TCK)" '{ print int(($14 + $15) / hz) }' "/proc/$1/stat" 2> /dev/null || echo 0; }
 spent_on() { awk -F'\t' -v t="$1" '$1 == t { s += $2 } END { print s + 0 }' "$ledger"; }
 
+# minimise TARGET: the kept corpus becomes the smallest inputs of the kept corpus and the build's
+# corpus that add coverage to the seeds (libFuzzer's -merge=1 keeps every input of its first folder,
+# here a copy of the seeds, and adds the others smallest first when they bring a new feature).
+minimise() {
+  local t=$1 seeds="$build/fuzz/seeds/$1" merged="$build/fuzz/merged/$1" kept="$here/fuzz/corpus/$1"
+  rm -rf "$merged"; mkdir -p "$merged"
+  cp -r "$seeds"/. "$merged"/
+  if ! "$build/fuzz/fuzz_$t" -merge=1 -timeout=60 -rss_limit_mb=2048 "$merged" "$kept" "$build/fuzz/corpus/$t" \
+         > "$build/fuzz/$t.merge.log" 2>&1; then
+    echo "fuzz_$t: the merge failed (log $build/fuzz/$t.merge.log); the kept corpus is unchanged"
+    return 1
+  fi
+  (cd "$seeds" && find . -type f -exec rm -f "$merged/{}" \;)
+  rm -rf "$kept"; mv "$merged" "$kept"
+}
+size_of() { find "$1" -type f -printf '%s\n' | awk '{ n++; b += $1 } END { printf "%d files, %d bytes", n, b }'; }
+# coverage TARGET: libFuzzer's coverage of the seeds and the kept corpus, "cov: EDGES ft: FEATURES".
+coverage() {
+  "$build/fuzz/fuzz_$1" -runs=0 -timeout=60 -rss_limit_mb=2048 "$here/fuzz/corpus/$1" "$build/fuzz/seeds/$1" 2>&1 |
+    grep -oE 'INITED cov: [0-9]+ ft: [0-9]+' | sed 's/INITED //'
+}
+
 status=0
 for t in "${targets[@]}"; do
   corpus="$build/fuzz/corpus/$t"
@@ -44,6 +76,12 @@ for t in "${targets[@]}"; do
   kept="$here/fuzz/corpus/$t"
   mkdir -p "$corpus" "$crashes" "$kept"
   log="$build/fuzz/$t.log"
+  if [ $minimise_only -eq 1 ]; then
+    before="$(coverage "$t"); kept $(size_of "$kept")"
+    minimise "$t" || status=1
+    echo "fuzz_$t: seeds and kept corpus before: $before; after: $(coverage "$t"); kept $(size_of "$kept")"
+    continue
+  fi
   if [ $campaign -eq 1 ]; then
     budget=$((seconds - $(spent_on "$t")))
     if [ $budget -le 0 ]; then echo "fuzz_$t: campaign done ($(spent_on "$t") CPU s in $ledger)"; continue; fi
@@ -88,15 +126,7 @@ for t in "${targets[@]}"; do
       echo "fuzz_$t: $used CPU s, $runs executions, coverage $cov, no finding ($(( $(spent_on "$t") + used )) CPU s in all)"
     fi
     printf '%s\t%s\t%s\t%s\t%s\n' "$t" "$used" "$runs" "$result" "$cov" >> "$ledger"
-    # Minimise: the kept corpus becomes the smallest set with the coverage of both.
-    merged="$build/fuzz/merged/$t"
-    rm -rf "$merged"; mkdir -p "$merged"
-    if "$build/fuzz/fuzz_$t" -merge=1 -timeout=60 -rss_limit_mb=2048 "$merged" "$kept" "$corpus" \
-         > "$build/fuzz/$t.merge.log" 2>&1; then
-      rm -rf "$kept"; mv "$merged" "$kept"
-    else
-      echo "fuzz_$t: the merge failed (log $build/fuzz/$t.merge.log); the kept corpus is unchanged"; status=1
-    fi
+    minimise "$t" || status=1
     continue
   fi
   # New inputs go to corpus/ (kept between runs of one build folder); the kept corpus and seeds/ are read only.

@@ -7,7 +7,8 @@
 //   seeds/session_csv/     the same motion as a session file, written by SessionRecorder
 //   seeds/profile_csv/     the same motion as a force profile, written by write_profile_csv
 //   seeds/device_protocol/ the same motion as device-state datagrams, then a force command
-//   seeds/reference_checkpoint/ the same motion as a reference checkpoint (kerf's own writer)
+//   seeds/reference_checkpoint/ the same motion as a reference checkpoint (kerf's own writer), and
+//                          its first two samples alone (a small checkpoint)
 //   seeds/replay/          the trajectory CSVs and session files above (both are replay files)
 //   seeds/study/           the study files given with --study, copied, and each again with a
 //                          [calibration] entry for its first scene naming calibrated.toml (the
@@ -91,6 +92,41 @@ void write_quantity_seeds(const fs::path& scene_file, const fs::path& out, std::
   }
 }
 
+/// A reference checkpoint of `tool`'s rows of `profile` (at most `max_samples` of them) as solved
+/// samples, with the manifest record of each (reference_run.cpp's fields; the energy record as
+/// EnergyBookkeeping::to_json writes it) and its positions as the solver state.
+ReferenceCheckpoint reference_checkpoint_seed(const ForceProfile& profile, const std::string& tool,
+                                              std::size_t stride, std::size_t max_samples) {
+  ReferenceCheckpoint checkpoint;
+  checkpoint.scene_sha256 = std::string(64, '0');
+  checkpoint.degree = 1;
+  checkpoint.processes = 1;
+  for (const ProfileRow& row : profile.rows) {
+    if (row.tool != tool) continue;
+    if (checkpoint.indices.size() == max_samples) break;
+    const std::size_t k = checkpoint.indices.size();
+    checkpoint.indices.push_back(k * stride);
+    checkpoint.profile.rows.push_back(row);
+    for (int d = 0; d < 3; ++d) checkpoint.state.push_back(row.position[d]);
+    const nlohmann::json p = {row.position.x(), row.position.y(), row.position.z()};
+    const nlohmann::json f = {row.force.x(), row.force.y(), row.force.z()};
+    checkpoint.samples.push_back({{"index", k * stride}, {"t_s", row.t}, {"newton_iterations", 3}, {"cutbacks", 0},
+                                  {"increments", 1}, {"residual_N", 1e-9}, {"seconds", 0.01}, {"tool_force_N", f},
+                                  {"support_reaction_N", f}, {"contact_points", static_cast<int>(k % 2)},
+                                  {"energy", {{"external_work_J", 0.0}, {"stored_elastic_energy_J", 0.0},
+                                              {"interface_energy_J", 0.0}, {"cohesive_dissipation_J", 0.0},
+                                              {"viscous_dissipation_J", 0.0}, {"friction_dissipation_J", 0.0},
+                                              {"failed_area_m2", 0.0}, {"balance_error", 0.0},
+                                              {"last_positions_m", nlohmann::json::array({p})},
+                                              {"last_forces_on_body_N", nlohmann::json::array({f})}}}});
+    checkpoint.solve_seconds += 0.01;
+  }
+  checkpoint.solved = checkpoint.indices.size();
+  if (!checkpoint.profile.rows.empty()) checkpoint.last.tool_position = checkpoint.profile.rows.back().position;
+  checkpoint.last.load_factor = 1.0;
+  return checkpoint;
+}
+
 void write_motion_seeds(const Scene& scene, const fs::path& out) {
   const std::string name = scene.file.stem().string();
   std::vector<SampledTrajectory> motion;
@@ -146,36 +182,12 @@ void write_motion_seeds(const Scene& scene, const fs::path& out) {
                 fs::copy_options::overwrite_existing);
   write_profile_csv(profile, out / "profile_csv" / (name + ".csv"));
 
-  // Reference checkpoint: the first tool's rows as solved samples, with the manifest record of
-  // each (reference_run.cpp's fields; the energy record as EnergyBookkeeping::to_json writes it)
-  // and its positions as the solver state.
-  ReferenceCheckpoint checkpoint;
-  checkpoint.scene_sha256 = std::string(64, '0');
-  checkpoint.degree = 1;
-  checkpoint.processes = 1;
-  for (const ProfileRow& row : profile.rows) {
-    if (row.tool != scene.tools.front().name) continue;
-    const std::size_t k = checkpoint.indices.size();
-    checkpoint.indices.push_back(k * stride);
-    checkpoint.profile.rows.push_back(row);
-    for (int d = 0; d < 3; ++d) checkpoint.state.push_back(row.position[d]);
-    const nlohmann::json p = {row.position.x(), row.position.y(), row.position.z()};
-    const nlohmann::json f = {row.force.x(), row.force.y(), row.force.z()};
-    checkpoint.samples.push_back({{"index", k * stride}, {"t_s", row.t}, {"newton_iterations", 3}, {"cutbacks", 0},
-                                  {"increments", 1}, {"residual_N", 1e-9}, {"seconds", 0.01}, {"tool_force_N", f},
-                                  {"support_reaction_N", f}, {"contact_points", static_cast<int>(k % 2)},
-                                  {"energy", {{"external_work_J", 0.0}, {"stored_elastic_energy_J", 0.0},
-                                              {"interface_energy_J", 0.0}, {"cohesive_dissipation_J", 0.0},
-                                              {"viscous_dissipation_J", 0.0}, {"friction_dissipation_J", 0.0},
-                                              {"failed_area_m2", 0.0}, {"balance_error", 0.0},
-                                              {"last_positions_m", nlohmann::json::array({p})},
-                                              {"last_forces_on_body_N", nlohmann::json::array({f})}}}});
-    checkpoint.solve_seconds += 0.01;
-  }
-  checkpoint.solved = checkpoint.indices.size();
-  if (!checkpoint.profile.rows.empty()) checkpoint.last.tool_position = checkpoint.profile.rows.back().position;
-  checkpoint.last.load_factor = 1.0;
-  write_reference_checkpoint(checkpoint, out / "reference_checkpoint" / (name + ".bin"));
+  // Reference checkpoints: every kept sample of the first tool, and its first two samples only
+  // (a small seed: the fuzzer's mutations of it stay small, and so does the kept corpus).
+  write_reference_checkpoint(reference_checkpoint_seed(profile, scene.tools.front().name, stride, profile.rows.size()),
+                             out / "reference_checkpoint" / (name + ".bin"));
+  write_reference_checkpoint(reference_checkpoint_seed(profile, scene.tools.front().name, stride, 2),
+                             out / "reference_checkpoint" / (name + "_small.bin"));
 
   // Device protocol: length-prefixed datagrams (fuzz_targets.hpp), the first tool's motion.
   std::vector<std::byte> stream;

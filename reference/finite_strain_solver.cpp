@@ -92,8 +92,11 @@ template <class Algebra> EquilibriumReport FiniteStrainSolver::Impl::solve(Algeb
 std::size_t FiniteStrainSolver::dof_count() const { return m_impl->dof.n_dofs(); }
 std::size_t FiniteStrainSolver::cell_count() const { return m_impl->tria.n_active_cells(); }
 std::string FiniteStrainSolver::linear_solver_name() const { return m_impl->linear->name(); }
+std::string FiniteStrainSolver::linear_solver_reason() const { return m_impl->linear->choice_reason(); }
 double FiniteStrainSolver::contact_penalty() const { return m_impl->penalty; }
-std::size_t FiniteStrainSolver::cohesive_point_count() const { return m_impl->cohesive_states.size(); }
+std::size_t FiniteStrainSolver::cohesive_point_count() const {
+  return m_impl->cohesive_law ? m_impl->cohesive_pair_total * m_impl->face_quadrature->size() : 0;
+}
 double FiniteStrainSolver::crack_extent(const Eigen::Vector3d& direction) const {
   const Impl& m = *m_impl;
   if (!m.cohesive_law) return 0.0;
@@ -105,6 +108,9 @@ double FiniteStrainSolver::crack_extent(const Eigen::Vector3d& direction) const 
     for (std::size_t q = 0; q < nq; ++q)
       if (m.cohesive_states[p * nq + q].max_opening >= df) reach = std::max(reach, m.cohesive_pairs[p].points[q].dot(direction));
   }
+  // Distributed: over every process's pairs.
+  first = m.min(first);
+  reach = m.max(reach);
   return reach > first ? reach - first : 0.0;
 }
 double FiniteStrainSolver::max_displacement() const {
@@ -118,6 +124,16 @@ double FiniteStrainSolver::max_displacement() const {
 double FiniteStrainSolver::kinetic_energy() const { return m_impl->dynamics ? m_impl->dynamics->kinetic_energy : 0.0; }
 double FiniteStrainSolver::damping_dissipation() const {
   return m_impl->dynamics ? m_impl->dynamics->damping_dissipation : 0.0;
+}
+
+SolverTimings FiniteStrainSolver::timings() const {
+  const Impl& m = *m_impl;
+  SolverTimings t = m.timings;
+  if (m.parallel) t.communication_seconds += m.parallel->exchange_seconds;
+  const TangentSolver::Timings linear = m.linear->timings();
+  t.factorization_seconds = linear.setup_seconds;
+  t.solve_seconds = linear.solve_seconds;
+  return t;
 }
 
 int FiniteStrainSolver::process_count() const { return m_impl->distributed ? m_impl->process_count : 1; }

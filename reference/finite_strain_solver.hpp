@@ -207,7 +207,8 @@ struct SolverSettings {
   /// Newton's tangent gaining 4 M/h². A solve at the same time as the last one (h = 0, e.g. the
   /// first sample) is quasi-static and leaves v and a unchanged; the body starts at rest (v = a = 0).
   /// Reactions (and the tool forces of tied styluses) include the inertia of the driven nodes.
-  /// Serial only (a distributed mesh is refused). Every material region needs a density > 0.
+  /// Distributed too (u_n, v_n, a_n gathered on every process when a step is committed). Every
+  /// material region needs a density > 0.
   /// A region's `damping` η > 0 adds the Kelvin–Voigt viscous stress (MaterialRegion::damping), its
   /// velocity v_{n+1} = 2/h (u_{n+1} − u_n) − v_n (γ/(βh) = 2/h in Newton's tangent).
   bool dynamic = false;
@@ -237,6 +238,24 @@ struct CohesiveSummary {
   double step_time_integration_error = 0.0;
   double step_dissipation = 0.0; ///< dynamic step only: the step's increase of dissipated_energy [J]
   double max_damage = 0.0;         ///< largest 1 − K(κ)/K_0 over the points
+};
+
+/// Where a solver's time went, summed over its solves since construction: this process's wall
+/// clock [s]. The parts do not overlap; the rest of a solve (line-search vector updates, norms,
+/// constraints, the commit of a converged step) is the difference to its whole time.
+struct SolverTimings {
+  /// Residual and tangent assembly: the cells, the tool contact (flanks and edge pass), the
+  /// foundations and the cohesive interface (the communication inside excluded).
+  double assembly_seconds = 0.0;
+  /// The linear solver's set-up: factorisations (CHOLMOD/UMFPACK with their analyses, MUMPS) or
+  /// the preconditioner's (GAMG); communication inside MUMPS and GAMG included.
+  double factorization_seconds = 0.0;
+  /// Forward and back substitutions, or the Krylov iterations.
+  double solve_seconds = 0.0;
+  /// Distributed: the ghost values' exchange, the assembled matrix's and vectors' exchange
+  /// (compress), the reductions of norms, tallies and the edge pass's boundary displacements —
+  /// waiting for the other processes (load imbalance) included. 0 on one process.
+  double communication_seconds = 0.0;
 };
 
 /// The reaction at one displacement boundary: the force the body puts on that support.
@@ -312,6 +331,12 @@ public:
   /// "cholmod/umfpack" (serial direct, sparse_direct.hpp), "mumps" (distributed direct) or
   /// "petsc-cg-gamg": what `solve` uses.
   [[nodiscard]] std::string linear_solver_name() const;
+  /// Why `linear_solver_name()` (LinearSolverChoice::automatic: the DOF count against
+  /// direct_dof_limit, CHOLMOD's predicted factor against direct_factor_limit — on one process or
+  /// gathered from all — and, when GAMG did not converge on a system, that the direct solver took
+  /// over from there and why), e.g. "direct: 63498 DOFs > direct_dof_limit 60000; predicted
+  /// Cholesky factor 2.9e+07 entries <= direct_factor_limit 1e+08".
+  [[nodiscard]] std::string linear_solver_reason() const;
   /// The contact penalty in use [Pa/m].
   [[nodiscard]] double contact_penalty() const;
   /// The number of MPI processes the mesh is distributed over (1: serial).
@@ -319,6 +344,7 @@ public:
   /// Cohesive interface: its quadrature points (0 without one) and how far the failed part
   /// reaches along `direction` (unit) beyond the interface's first point along it [m] — the crack
   /// depth c of paper 001 Fig. 3 when `direction` is the cutting direction; 0 if nothing failed.
+  /// Both of the whole interface; crack_extent is collective when distributed.
   [[nodiscard]] std::size_t cohesive_point_count() const;
   [[nodiscard]] double crack_extent(const Eigen::Vector3d& direction) const;
 
@@ -337,14 +363,18 @@ public:
   [[nodiscard]] double kinetic_energy() const;
   /// Kelvin–Voigt dissipation so far [J] (EquilibriumReport::damping_dissipation; 0 undamped).
   [[nodiscard]] double damping_dissipation() const;
+  /// Where this process's solve time went so far (SolverTimings).
+  [[nodiscard]] SolverTimings timings() const;
 
   /// The state for a checkpoint: the DOF values of the displacement, all of them in global DOF
   /// order on every process (distributed: gathered; the numbering depends on the process count,
   /// so a state is restored with the same number of processes), followed (with a cohesive
-  /// interface) by each interface point's history (κ, previous opening) and the last time, and
+  /// interface) by each interface point's history (κ, previous opening), in the order of the whole
+  /// interface's face pairs (the same for any process count), the last time and the viscous
+  /// dissipation, and
   /// (with SolverSettings::dynamic) by the velocity and acceleration DOFs, the last time and the
   /// interface's trapezoid work (CohesiveSummary::trapezoid_work), and (dynamic with damping in
-  /// some region) the Kelvin–Voigt dissipation so far.
+  /// some region) the Kelvin–Voigt dissipation so far. Collective when distributed.
   [[nodiscard]] std::vector<double> state() const;
   /// Restores a checkpointed state. Throws std::invalid_argument on a size mismatch.
   void set_state(const std::vector<double>& values);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <chrono>
 #include <cstdio>
+#include <utility>
 
 namespace kerf::reference {
 
@@ -15,8 +16,8 @@ LoadState interpolate(const LoadState& a, const LoadState& b, double f) {
   return out;
 }
 
-LoadPath::LoadPath(FiniteStrainSolver& solver, const LoadState& start, const LoadPathSettings& settings)
-    : m_solver(solver), m_settings(settings), m_last(start), m_state(solver.state()) {
+LoadPath::LoadPath(FiniteStrainSolver& solver, const LoadState& start, const LoadPathSettings& settings, LoadMotion motion)
+    : m_solver(solver), m_settings(settings), m_motion(std::move(motion)), m_last(start), m_state(solver.state()) {
   if (settings.max_cutbacks < 0)
     throw std::invalid_argument("load path: max_cutbacks must be >= 0, got " + std::to_string(settings.max_cutbacks));
   if (!(settings.interface_error_relative >= 0.0) || !(settings.interface_error_absolute >= 0.0) ||
@@ -51,7 +52,7 @@ LoadStepReport LoadPath::advance(const LoadTarget& target) {
   if (control && m_interface_step > 0.0 && span > 0.0) step = std::min(1.0, m_interface_step / span);
   while (done < 1.0) {
     const double f = std::min(1.0, done + step);
-    const LoadState trial = f >= 1.0 ? target.load : interpolate(from, target.load, f);
+    const LoadState trial = f >= 1.0 ? target.load : between(from, target.load, f);
     const EquilibriumReport r = m_solver.solve(trial);
     out.newton_iterations += r.newton_iterations;
     bool grow = false;
@@ -109,6 +110,11 @@ LoadStepReport LoadPath::advance(const LoadTarget& target) {
   out.final_residual = out.equilibrium.residual_history.empty() ? 0.0 : out.equilibrium.residual_history.back();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   return out;
+}
+
+LoadState LoadPath::between(const LoadState& from, const LoadState& to, double f) const {
+  if (!m_motion) return interpolate(from, to, f);
+  return m_motion(from.time + f * (to.time - from.time));
 }
 
 std::vector<LoadStepReport> LoadPath::run(const std::vector<LoadTarget>& targets) {

@@ -1,10 +1,12 @@
 #pragma once
 // The load path of a reference run: a sequence of loads (one per trajectory sample to solve)
 // driven through FiniteStrainSolver with automatic cut-back. A load that does not converge is
-// retried from the last converged load in halved increments (bisection of the interval between the
-// last converged load and the target, tool position and load factor interpolated linearly), up to
-// a bounded number of cut-backs; then the path stops with LoadPathError, the solver left at the
-// last converged state (issue 3, "a step that does not converge is cut back automatically").
+// retried from the last converged load in halved increments (bisection of the time interval
+// between the last converged load and the target), up to a bounded number of cut-backs; then the
+// path stops with LoadPathError, the solver left at the last converged state. The loads between
+// two targets are those of the motion (LoadPath's `motion`: the tool where the trajectory has it
+// at that time), so a cut-back follows the trajectory, not the chord between the two targets;
+// without a motion they are interpolated linearly.
 // With the interface energy control (LoadPathSettings::interface_error_relative/absolute; the
 // dynamic step with a cohesive interface) a converged increment whose time integration error at
 // the cohesive law's kinks is too large is rejected the same way: the solver is restored to the
@@ -17,6 +19,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -83,17 +86,23 @@ private:
   double m_time;
 };
 
+/// The load at time t [s]: the tool where its trajectory has it, and the load factor of t.
+using LoadMotion = std::function<LoadState(double time)>;
+
 /// Drives a FiniteStrainSolver along loads with cut-back (see file comment). Holds the last
 /// converged load and the solver state there (FiniteStrainSolver::state()).
 class LoadPath {
 public:
   /// `start` is the load at which the solver's current state is in equilibrium (for a fresh
-  /// solver: zero load factor and the tool's first position). Throws std::invalid_argument on a
+  /// solver: zero load factor and the tool's first position). `motion` gives the loads between
+  /// two targets (empty: linear interpolation of the two). Throws std::invalid_argument on a
   /// negative max_cutbacks.
-  LoadPath(FiniteStrainSolver& solver, const LoadState& start, const LoadPathSettings& settings = {});
+  LoadPath(FiniteStrainSolver& solver, const LoadState& start, const LoadPathSettings& settings = {},
+           LoadMotion motion = {});
 
   /// Solves `target` from the last converged load. Attempt the whole increment; on failure halve
-  /// it (from the last converged sub-load: load(f) = last + f (target − last), f = ½, ¼, …) and
+  /// it (from the last converged sub-load: the load at time t_last + f (t_target − t_last),
+  /// f = ½, ¼, …, on the motion, or last + f (target − last) without one) and
   /// continue towards the target from each converged sub-load with the increment that worked.
   /// After `max_cutbacks` failures throws LoadPathError and leaves the solver at the last
   /// converged state. A converged increment that fails the interface energy control (see
@@ -114,8 +123,12 @@ public:
   void set_interface_step(double seconds) { m_interface_step = seconds > 0.0 ? seconds : 0.0; }
 
 private:
+  /// The load a fraction f of the way in time from `from` to `to` (on the motion when there is one).
+  [[nodiscard]] LoadState between(const LoadState& from, const LoadState& to, double f) const;
+
   FiniteStrainSolver& m_solver;
   LoadPathSettings m_settings;
+  LoadMotion m_motion;
   LoadState m_last;
   std::vector<double> m_state;
   double m_interface_step = 0.0;

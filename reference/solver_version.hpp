@@ -19,6 +19,8 @@ namespace kerf::reference {
 // 4: quadratic tetrahedra integrate their stresses and tangent with Witherden and Vincent's
 //    8-point rule (degree 3) instead of the 14-point one (degree 5); Newton accepts a stall of
 //    |R| within ten times its tolerance.
-inline constexpr int solver_version = 4;
+// 5: the load path follows the trajectory: every vertex of the motion is a load, and the loads
+//    between two targets (cut-backs) lie on the trajectory, not on the chord.
+inline constexpr int solver_version = 5;
 
 } // namespace kerf::reference

@@ -168,39 +168,74 @@ double SparseDirect::cholesky_factor_entries() {
   return m_cholmod->common.lnz;
 }
 
+namespace {
+
+/// The lower triangle of a symmetric pattern in compressed columns, as CHOLMOD takes it: column j
+/// holds row j's columns c >= j (sorted); `source[k]` = the pattern entry of CSC entry k.
+struct LowerColumns {
+  std::vector<std::int64_t> col_start{0}, row_index, source;
+};
+
+LowerColumns lower_columns(std::size_t n, const std::vector<std::int64_t>& row_start, const std::vector<std::int64_t>& columns) {
+  LowerColumns out;
+  std::vector<std::pair<std::int64_t, std::int64_t>> entries; // (row, source) of one column
+  for (std::size_t j = 0; j < n; ++j) {
+    entries.clear();
+    for (std::int64_t e = row_start[j]; e < row_start[j + 1]; ++e)
+      if (columns[static_cast<std::size_t>(e)] >= static_cast<std::int64_t>(j)) entries.emplace_back(columns[static_cast<std::size_t>(e)], e);
+    std::sort(entries.begin(), entries.end());
+    for (const auto& [i, e] : entries) {
+      out.row_index.push_back(i);
+      out.source.push_back(e);
+    }
+    out.col_start.push_back(static_cast<std::int64_t>(out.row_index.size()));
+  }
+  return out;
+}
+
+/// CHOLMOD's symbolic analysis (fill-reducing ordering, supernodal structure) of `A`'s pattern.
+cholmod_factor* analyze(cholmod_sparse* A, cholmod_common& common) {
+  const SerialOpenMP serial;
+  // METIS, among the orderings the analysis tries, seeds and draws from the C library's rand(),
+  // which gmsh uses too (meshes/c_random_generator.hpp).
+  const std::lock_guard<std::mutex> random(c_random_generator_mutex());
+  return cholmod_l_analyze(A, &common);
+}
+} // namespace
+
 void SparseDirect::analyze_cholesky() {
   if (!m_cholmod) {
     const auto t0 = Clock::now();
     m_cholmod = std::make_unique<Cholmod>();
     Cholmod& c = *m_cholmod;
-    std::vector<std::pair<std::int64_t, std::int64_t>> entries; // (row, source) of one column
-    std::vector<std::int64_t> col_start{0}, row_index;
-    for (std::size_t j = 0; j < m_n; ++j) {
-      entries.clear();
-      for (std::int64_t e = m_row_start[j]; e < m_row_start[j + 1]; ++e)
-        if (m_columns[static_cast<std::size_t>(e)] >= static_cast<std::int64_t>(j)) entries.emplace_back(m_columns[static_cast<std::size_t>(e)], e);
-      std::sort(entries.begin(), entries.end());
-      for (const auto& [i, e] : entries) {
-        row_index.push_back(i);
-        c.source.push_back(e);
-      }
-      col_start.push_back(static_cast<std::int64_t>(row_index.size()));
-    }
-    c.A = cholmod_l_allocate_sparse(m_n, m_n, row_index.size(), 1, 1, -1, CHOLMOD_REAL, &c.common);
+    LowerColumns lower = lower_columns(m_n, m_row_start, m_columns);
+    c.source = std::move(lower.source);
+    c.A = cholmod_l_allocate_sparse(m_n, m_n, lower.row_index.size(), 1, 1, -1, CHOLMOD_REAL, &c.common);
     if (c.A == nullptr) throw std::runtime_error("SparseDirect: CHOLMOD could not allocate the matrix");
-    std::copy(col_start.begin(), col_start.end(), static_cast<SuiteSparse_long*>(c.A->p));
-    std::copy(row_index.begin(), row_index.end(), static_cast<SuiteSparse_long*>(c.A->i));
-    const SerialOpenMP serial;
-    {
-      // METIS, among the orderings the analysis tries, seeds and draws from the C library's
-      // rand(), which gmsh uses too (meshes/c_random_generator.hpp).
-      const std::lock_guard<std::mutex> random(c_random_generator_mutex());
-      c.L = cholmod_l_analyze(c.A, &c.common);
-    }
+    std::copy(lower.col_start.begin(), lower.col_start.end(), static_cast<SuiteSparse_long*>(c.A->p));
+    std::copy(lower.row_index.begin(), lower.row_index.end(), static_cast<SuiteSparse_long*>(c.A->i));
+    c.L = analyze(c.A, c.common);
     if (c.L == nullptr || c.common.status < CHOLMOD_OK)
       throw std::runtime_error("SparseDirect: CHOLMOD's analysis failed (status " + std::to_string(c.common.status) + ")");
     m_counters.analysis_seconds += seconds_since(t0);
   }
+}
+
+double SparseDirect::predict_cholesky_factor_entries(std::size_t n, const std::vector<std::int64_t>& row_start,
+                                                     const std::vector<std::int64_t>& columns) {
+  if (row_start.size() != n + 1 || row_start.back() != static_cast<std::int64_t>(columns.size()))
+    throw std::invalid_argument("SparseDirect: the row starts do not describe " + std::to_string(n) + " rows of " +
+                                std::to_string(columns.size()) + " entries");
+  Cholmod c; // its settings (supernodal) are the factorisation's
+  const LowerColumns lower = lower_columns(n, row_start, columns);
+  c.A = cholmod_l_allocate_sparse(n, n, lower.row_index.size(), 1, 1, -1, CHOLMOD_PATTERN, &c.common);
+  if (c.A == nullptr) throw std::runtime_error("SparseDirect: CHOLMOD could not allocate the pattern");
+  std::copy(lower.col_start.begin(), lower.col_start.end(), static_cast<SuiteSparse_long*>(c.A->p));
+  std::copy(lower.row_index.begin(), lower.row_index.end(), static_cast<SuiteSparse_long*>(c.A->i));
+  c.L = analyze(c.A, c.common);
+  if (c.L == nullptr || c.common.status < CHOLMOD_OK)
+    throw std::runtime_error("SparseDirect: CHOLMOD's analysis failed (status " + std::to_string(c.common.status) + ")");
+  return c.common.lnz;
 }
 
 bool SparseDirect::factorize_cholesky(const std::vector<double>& values) {

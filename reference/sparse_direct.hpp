@@ -44,6 +44,12 @@ public:
   /// fill-reducing ordering; the analysis is kept for the factorisations): the memory a direct
   /// solve needs, 8 bytes an entry for L (UMFPACK's LU, when it takes over, several times that).
   [[nodiscard]] double cholesky_factor_entries();
+  /// The same prediction for a pattern given in compressed rows (as the constructor takes it),
+  /// without building a solver: CHOLMOD's analysis of the same lower triangle, so a pattern gives
+  /// the same number either way (the distributed solver's automatic choice gathers its pattern
+  /// and asks this, tangent_solver.hpp).
+  [[nodiscard]] static double predict_cholesky_factor_entries(std::size_t n, const std::vector<std::int64_t>& row_start,
+                                                              const std::vector<std::int64_t>& columns);
 
   /// Work counters since construction.
   struct Counters {

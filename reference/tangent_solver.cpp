@@ -5,8 +5,14 @@
 
 #include <petscksp.h>
 
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
+#include <utility>
 
 namespace kerf::reference {
 
@@ -16,10 +22,10 @@ void check(PetscErrorCode code, const char* what) {
   if (code != 0) throw std::runtime_error(std::string("PETSc error ") + std::to_string(code) + " in " + what);
 }
 
-/// CG on the true residual, preconditioned by GAMG (the near null space is set on the matrix).
 /// CG (SPD tangents) or GMRES (indefinite ones: right-preconditioned, so that its residual is the
-/// true one; restart 200) with GAMG, stopping at a true residual of `tolerance` |b|.
-void configure_krylov_gamg(KSP ksp, double tolerance, bool spd) {
+/// true one; restart 200), preconditioned by GAMG (the near null space is set on the matrix),
+/// stopping at a true residual of `tolerance` |b| or failing after `max_iterations`.
+void configure_krylov(KSP ksp, double tolerance, bool spd, int max_iterations) {
   if (spd) {
     check(KSPSetType(ksp, KSPCG), "KSPSetType");
   } else {
@@ -28,7 +34,12 @@ void configure_krylov_gamg(KSP ksp, double tolerance, bool spd) {
     check(KSPSetPCSide(ksp, PC_RIGHT), "KSPSetPCSide");
   }
   check(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED), "KSPSetNormType");
-  check(KSPSetTolerances(ksp, tolerance, 1e-300, PETSC_DEFAULT, 5000), "KSPSetTolerances");
+  check(KSPSetTolerances(ksp, tolerance, 1e-300, PETSC_DEFAULT, max_iterations), "KSPSetTolerances");
+}
+
+/// The Krylov solver with a fresh GAMG preconditioner; PETSc's options (PETSC_OPTIONS) may override.
+void configure_krylov_gamg(KSP ksp, double tolerance, bool spd, int max_iterations) {
+  configure_krylov(ksp, tolerance, spd, max_iterations);
   PC pc = nullptr;
   check(KSPGetPC(ksp, &pc), "KSPGetPC");
   check(PCSetType(pc, PCGAMG), "PCSetType");
@@ -53,17 +64,30 @@ void set_rigid_body_modes(Mat A, MPI_Comm comm, const std::vector<dealii::Point<
   VecDestroy(&coords);
 }
 
-/// Runs the KSP; throws naming the solver if it did not converge. Returns the iteration count.
-int run_ksp(KSP ksp, Vec b, Vec x, const std::string& name) {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Runs the KSP: its reason and iteration count. The set-up (MUMPS's factorisation, GAMG's
+/// hierarchy; KSPSolve would run it first anyway) and the solve are timed apart into `timings`.
+std::pair<KSPConvergedReason, int> run_ksp(KSP ksp, Vec b, Vec x, TangentSolver::Timings& timings) {
+  check(VecSet(x, 0.0), "VecSet");
+  auto t0 = std::chrono::steady_clock::now();
+  check(KSPSetUp(ksp), "KSPSetUp");
+  timings.setup_seconds += seconds_since(t0);
+  t0 = std::chrono::steady_clock::now();
   check(KSPSolve(ksp, b, x), "KSPSolve");
+  timings.solve_seconds += seconds_since(t0);
   KSPConvergedReason reason;
   check(KSPGetConvergedReason(ksp, &reason), "KSPGetConvergedReason");
   PetscInt iterations = 0;
   check(KSPGetIterationNumber(ksp, &iterations), "KSPGetIterationNumber");
-  if (reason < 0)
-    throw std::runtime_error(name + " did not converge (reason " + std::to_string(static_cast<int>(reason)) +
-                             " after " + std::to_string(iterations) + " iterations)");
-  return static_cast<int>(iterations);
+  return {reason, static_cast<int>(iterations)};
+}
+
+[[noreturn]] void throw_not_converged(const std::string& name, KSPConvergedReason reason, int iterations) {
+  throw std::runtime_error(name + " did not converge (reason " + std::to_string(static_cast<int>(reason)) + " after " +
+                           std::to_string(iterations) + " iterations)");
 }
 
 } // namespace
@@ -72,7 +96,11 @@ struct TangentSolver::Petsc {
   Mat A = nullptr;
   Vec x = nullptr, b = nullptr;
   KSP ksp = nullptr;
+  KSP gmres = nullptr; ///< CG's fallback on an indefinite system: GMRES sharing ksp's preconditioner
+  KSP mumps = nullptr; ///< distributed direct solver (Kind::direct, or the iterative one's fall-back)
   ~Petsc() {
+    if (mumps) KSPDestroy(&mumps);
+    if (gmres) KSPDestroy(&gmres);
     if (ksp) KSPDestroy(&ksp);
     if (x) VecDestroy(&x);
     if (b) VecDestroy(&b);
@@ -81,14 +109,61 @@ struct TangentSolver::Petsc {
 };
 
 TangentSolver::TangentSolver(Kind kind, std::vector<dealii::Point<3>> coordinates, double tol, bool distributed,
-                             bool spd)
-    : m_kind(kind), m_coordinates(std::move(coordinates)), m_tolerance(tol), m_distributed(distributed), m_spd(spd) {}
+                             bool spd, IterativeSettings iterative)
+    : m_kind(kind), m_coordinates(std::move(coordinates)), m_tolerance(tol), m_distributed(distributed), m_spd(spd),
+      m_iterative(iterative) {}
+
+int TangentSolver::run_iterative(Vec b, Vec x) {
+  const std::string name = m_spd ? "PETSc CG + GAMG" : "PETSc GMRES + GAMG";
+  auto [reason, iterations] = run_ksp(m_petsc->ksp, b, x, m_petsc_timings);
+  ++m_iterative_counters.solves;
+  m_iterative_counters.iterations += iterations;
+  if (m_spd && (reason == KSP_DIVERGED_INDEFINITE_MAT || reason == KSP_DIVERGED_INDEFINITE_PC)) {
+    // CG met p·Kp <= 0 or r·Mr <= 0: this tangent (or GAMG built on it) is indefinite. GMRES
+    // with the same preconditioner (already set up for this matrix) solves it.
+    if (!m_petsc->gmres) {
+      MPI_Comm comm = MPI_COMM_NULL;
+      check(PetscObjectGetComm(reinterpret_cast<PetscObject>(m_petsc->ksp), &comm), "PetscObjectGetComm");
+      check(KSPCreate(comm, &m_petsc->gmres), "KSPCreate");
+      // At most 1000 iterations: where GMRES + GAMG converges on these tangents it does so in a
+      // few hundred (five restarts); a system it cannot solve should fail in seconds, not minutes.
+      configure_krylov(m_petsc->gmres, m_tolerance, false, std::min(m_iterative.max_iterations, 1000));
+      PC pc = nullptr;
+      check(KSPGetPC(m_petsc->ksp, &pc), "KSPGetPC");
+      check(KSPSetPC(m_petsc->gmres, pc), "KSPSetPC");
+    }
+    Mat A = nullptr, P = nullptr;
+    check(KSPGetOperators(m_petsc->ksp, &A, &P), "KSPGetOperators");
+    check(KSPSetOperators(m_petsc->gmres, A, P), "KSPSetOperators");
+    const int cg_iterations = iterations;
+    std::tie(reason, iterations) = run_ksp(m_petsc->gmres, b, x, m_petsc_timings);
+    ++m_iterative_counters.indefinite_to_gmres;
+    m_iterative_counters.iterations += iterations;
+    if (reason < 0)
+      throw std::runtime_error(name + " met an indefinite system after " + std::to_string(cg_iterations) +
+                               " iterations and GMRES did not converge either (reason " +
+                               std::to_string(static_cast<int>(reason)) + " after " + std::to_string(iterations) +
+                               " iterations)");
+    return cg_iterations + iterations;
+  }
+  if (reason < 0) throw_not_converged(name, reason, iterations);
+  return iterations;
+}
 
 TangentSolver::~TangentSolver() = default;
 
 std::string TangentSolver::name() const {
   if (m_kind == Kind::iterative) return m_spd ? "petsc-cg-gamg" : "petsc-gmres-gamg";
   return m_distributed ? "mumps" : "cholmod/umfpack";
+}
+
+TangentSolver::Timings TangentSolver::timings() const {
+  Timings t = m_petsc_timings;
+  if (m_direct) {
+    t.setup_seconds += m_direct->counters().analysis_seconds + m_direct->counters().factorization_seconds;
+    t.solve_seconds += m_direct->counters().solve_seconds;
+  }
+  return t;
 }
 
 void TangentSolver::make_direct(const dealii::SparsityPattern& pattern) {
@@ -127,13 +202,28 @@ void TangentSolver::solve_factorized(dealii::Vector<double>& x, const dealii::Ve
   m_direct->solve(b.begin(), x.begin());
 }
 
+void TangentSolver::switch_to_direct(const std::string& why) {
+  m_kind = Kind::direct;
+  m_reason += (m_reason.empty() ? "" : "; ") + std::string("then direct: ") + why;
+}
+
 int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<double>& x,
                          const dealii::Vector<double>& b) {
-  if (m_kind == Kind::direct) {
-    factorize(K);
-    solve_factorized(x, b);
-    return 0;
+  if (m_kind == Kind::iterative) {
+    try {
+      return solve_iterative(K, x, b);
+    } catch (const std::runtime_error& e) {
+      if (!m_fall_back) throw;
+      switch_to_direct(e.what());
+    }
   }
+  factorize(K);
+  solve_factorized(x, b);
+  return 0;
+}
+
+int TangentSolver::solve_iterative(const dealii::SparseMatrix<double>& K, dealii::Vector<double>& x,
+                                   const dealii::Vector<double>& b) {
   initialize_petsc();
   const auto n = static_cast<PetscInt>(K.m());
   if (!m_petsc) {
@@ -146,7 +236,7 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
     check(MatSetOption(m_petsc->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
     check(MatCreateVecs(m_petsc->A, &m_petsc->x, &m_petsc->b), "MatCreateVecs");
     check(KSPCreate(PETSC_COMM_SELF, &m_petsc->ksp), "KSPCreate");
-    configure_krylov_gamg(m_petsc->ksp, m_tolerance, m_spd);
+    configure_krylov_gamg(m_petsc->ksp, m_tolerance, m_spd, m_iterative.max_iterations);
   }
   // Copy the values row by row (PETSc sorts the columns).
   check(MatZeroEntries(m_petsc->A), "MatZeroEntries");
@@ -165,15 +255,14 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
   }
   check(MatAssemblyBegin(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
   check(MatAssemblyEnd(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
-  set_rigid_body_modes(m_petsc->A, PETSC_COMM_SELF, m_coordinates);
+  if (m_iterative.rigid_body_modes) set_rigid_body_modes(m_petsc->A, PETSC_COMM_SELF, m_coordinates);
   check(KSPSetOperators(m_petsc->ksp, m_petsc->A, m_petsc->A), "KSPSetOperators");
 
   PetscScalar* pb = nullptr;
   check(VecGetArray(m_petsc->b, &pb), "VecGetArray");
   for (PetscInt i = 0; i < n; ++i) pb[i] = b[static_cast<std::size_t>(i)];
   check(VecRestoreArray(m_petsc->b, &pb), "VecRestoreArray");
-  check(VecSet(m_petsc->x, 0.0), "VecSet");
-  const int iterations = run_ksp(m_petsc->ksp, m_petsc->b, m_petsc->x, m_spd ? "PETSc CG + GAMG" : "PETSc GMRES + GAMG");
+  const int iterations = run_iterative(m_petsc->b, m_petsc->x);
   const PetscScalar* px = nullptr;
   check(VecGetArrayRead(m_petsc->x, &px), "VecGetArrayRead");
   for (PetscInt i = 0; i < n; ++i) x[static_cast<std::size_t>(i)] = px[i];
@@ -183,68 +272,139 @@ int TangentSolver::solve(const dealii::SparseMatrix<double>& K, dealii::Vector<d
 
 int TangentSolver::solve(const dealii::PETScWrappers::MPI::SparseMatrix& K, dealii::PETScWrappers::MPI::Vector& x,
                          const dealii::PETScWrappers::MPI::Vector& b) {
-  const MPI_Comm comm = K.get_mpi_communicator();
-  Mat A = static_cast<Mat>(K);
-  if (!m_petsc) {
-    m_petsc = std::make_unique<Petsc>();
-    check(KSPCreate(comm, &m_petsc->ksp), "KSPCreate");
-    if (m_kind == Kind::direct) {
-      // MUMPS: a parallel sparse LU (the tangent with contact need not be symmetric).
-      check(KSPSetType(m_petsc->ksp, KSPPREONLY), "KSPSetType");
-      PC pc = nullptr;
-      check(KSPGetPC(m_petsc->ksp, &pc), "KSPGetPC");
-      check(PCSetType(pc, PCLU), "PCSetType");
-      check(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
-      check(KSPSetFromOptions(m_petsc->ksp), "KSPSetFromOptions");
-    } else {
-      // GAMG needs block size 3 for the rigid-body modes, which deal.II's matrix was created
-      // without: a copy with block size 3 and the same rows (preallocated once, values every step).
-      PetscInt first = 0, last = 0;
-      check(MatGetOwnershipRange(A, &first, &last), "MatGetOwnershipRange");
-      std::vector<PetscInt> diagonal(static_cast<std::size_t>(last - first)), off(diagonal.size());
-      for (PetscInt r = first; r < last; ++r) {
-        PetscInt ncols = 0;
-        const PetscInt* cols = nullptr;
-        check(MatGetRow(A, r, &ncols, &cols, nullptr), "MatGetRow");
-        for (PetscInt k = 0; k < ncols; ++k)
-          ++(cols[k] >= first && cols[k] < last ? diagonal : off)[static_cast<std::size_t>(r - first)];
-        check(MatRestoreRow(A, r, &ncols, &cols, nullptr), "MatRestoreRow");
-      }
-      check(MatCreate(comm, &m_petsc->A), "MatCreate");
-      check(MatSetSizes(m_petsc->A, last - first, last - first, PETSC_DETERMINE, PETSC_DETERMINE), "MatSetSizes");
-      check(MatSetBlockSize(m_petsc->A, 3), "MatSetBlockSize");
-      check(MatSetType(m_petsc->A, MATAIJ), "MatSetType");
-      check(MatMPIAIJSetPreallocation(m_petsc->A, 0, diagonal.data(), 0, off.data()), "MatMPIAIJSetPreallocation");
-      check(MatSeqAIJSetPreallocation(m_petsc->A, 0, diagonal.data()), "MatSeqAIJSetPreallocation");
-      check(MatSetOption(m_petsc->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
-      configure_krylov_gamg(m_petsc->ksp, m_tolerance, m_spd);
+  if (m_kind == Kind::iterative) {
+    // Collective: every process meets the same KSP reason, so all of them switch together.
+    try {
+      return solve_iterative(K, x, b);
+    } catch (const std::runtime_error& e) {
+      if (!m_fall_back) throw;
+      switch_to_direct(e.what());
     }
   }
-  if (m_kind == Kind::iterative) {
-    PetscInt first = 0, last = 0;
-    check(MatGetOwnershipRange(A, &first, &last), "MatGetOwnershipRange");
-    check(MatZeroEntries(m_petsc->A), "MatZeroEntries");
+  const MPI_Comm comm = K.get_mpi_communicator();
+  if (!m_petsc) m_petsc = std::make_unique<Petsc>();
+  if (!m_petsc->mumps) {
+    // MUMPS: a parallel sparse LU (the tangent with contact need not be symmetric).
+    check(KSPCreate(comm, &m_petsc->mumps), "KSPCreate");
+    check(KSPSetType(m_petsc->mumps, KSPPREONLY), "KSPSetType");
+    PC pc = nullptr;
+    check(KSPGetPC(m_petsc->mumps, &pc), "KSPGetPC");
+    check(PCSetType(pc, PCLU), "PCSetType");
+    check(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS), "PCFactorSetMatSolverType");
+    check(KSPSetFromOptions(m_petsc->mumps), "KSPSetFromOptions");
+  }
+  Mat A = static_cast<Mat>(K);
+  check(KSPSetOperators(m_petsc->mumps, A, A), "KSPSetOperators");
+  const auto [reason, iterations] = run_ksp(m_petsc->mumps, static_cast<const Vec&>(b), static_cast<const Vec&>(x),
+                                               m_petsc_timings);
+  if (reason < 0) throw_not_converged("MUMPS", reason, iterations);
+  return 0;
+}
+
+int TangentSolver::solve_iterative(const dealii::PETScWrappers::MPI::SparseMatrix& K, dealii::PETScWrappers::MPI::Vector& x,
+                                   const dealii::PETScWrappers::MPI::Vector& b) {
+  const MPI_Comm comm = K.get_mpi_communicator();
+  Mat A = static_cast<Mat>(K);
+  PetscInt first = 0, last = 0;
+  check(MatGetOwnershipRange(A, &first, &last), "MatGetOwnershipRange");
+  if (!m_petsc) m_petsc = std::make_unique<Petsc>();
+  if (!m_petsc->ksp) {
+    // GAMG needs block size 3 for the rigid-body modes, which deal.II's matrix was created
+    // without: a copy with block size 3 and the same rows (preallocated once, values every step).
+    std::vector<PetscInt> diagonal(static_cast<std::size_t>(last - first)), off(diagonal.size());
     for (PetscInt r = first; r < last; ++r) {
       PetscInt ncols = 0;
       const PetscInt* cols = nullptr;
-      const PetscScalar* vals = nullptr;
-      check(MatGetRow(A, r, &ncols, &cols, &vals), "MatGetRow");
-      check(MatSetValues(m_petsc->A, 1, &r, ncols, cols, vals, INSERT_VALUES), "MatSetValues");
-      check(MatRestoreRow(A, r, &ncols, &cols, &vals), "MatRestoreRow");
+      check(MatGetRow(A, r, &ncols, &cols, nullptr), "MatGetRow");
+      for (PetscInt k = 0; k < ncols; ++k)
+        ++(cols[k] >= first && cols[k] < last ? diagonal : off)[static_cast<std::size_t>(r - first)];
+      check(MatRestoreRow(A, r, &ncols, &cols, nullptr), "MatRestoreRow");
     }
-    check(MatAssemblyBegin(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
-    check(MatAssemblyEnd(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
-    set_rigid_body_modes(m_petsc->A, comm, m_coordinates);
-    A = m_petsc->A;
+    check(MatCreate(comm, &m_petsc->A), "MatCreate");
+    check(MatSetSizes(m_petsc->A, last - first, last - first, PETSC_DETERMINE, PETSC_DETERMINE), "MatSetSizes");
+    check(MatSetBlockSize(m_petsc->A, 3), "MatSetBlockSize");
+    check(MatSetType(m_petsc->A, MATAIJ), "MatSetType");
+    check(MatMPIAIJSetPreallocation(m_petsc->A, 0, diagonal.data(), 0, off.data()), "MatMPIAIJSetPreallocation");
+    check(MatSeqAIJSetPreallocation(m_petsc->A, 0, diagonal.data()), "MatSeqAIJSetPreallocation");
+    check(MatSetOption(m_petsc->A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE), "MatSetOption");
+    check(KSPCreate(comm, &m_petsc->ksp), "KSPCreate");
+    configure_krylov_gamg(m_petsc->ksp, m_tolerance, m_spd, m_iterative.max_iterations);
   }
-  check(KSPSetOperators(m_petsc->ksp, A, A), "KSPSetOperators");
-  Vec xv = static_cast<const Vec&>(x);
-  check(VecSet(xv, 0.0), "VecSet");
-  if (m_kind == Kind::direct) {
-    run_ksp(m_petsc->ksp, static_cast<const Vec&>(b), xv, "MUMPS");
-    return 0;
+  check(MatZeroEntries(m_petsc->A), "MatZeroEntries");
+  for (PetscInt r = first; r < last; ++r) {
+    PetscInt ncols = 0;
+    const PetscInt* cols = nullptr;
+    const PetscScalar* vals = nullptr;
+    check(MatGetRow(A, r, &ncols, &cols, &vals), "MatGetRow");
+    check(MatSetValues(m_petsc->A, 1, &r, ncols, cols, vals, INSERT_VALUES), "MatSetValues");
+    check(MatRestoreRow(A, r, &ncols, &cols, &vals), "MatRestoreRow");
   }
-  return run_ksp(m_petsc->ksp, static_cast<const Vec&>(b), xv, m_spd ? "PETSc CG + GAMG" : "PETSc GMRES + GAMG");
+  check(MatAssemblyBegin(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyBegin");
+  check(MatAssemblyEnd(m_petsc->A, MAT_FINAL_ASSEMBLY), "MatAssemblyEnd");
+  if (m_iterative.rigid_body_modes) set_rigid_body_modes(m_petsc->A, comm, m_coordinates);
+  check(KSPSetOperators(m_petsc->ksp, m_petsc->A, m_petsc->A), "KSPSetOperators");
+  return run_iterative(static_cast<const Vec&>(b), static_cast<const Vec&>(x));
+}
+
+double distributed_cholesky_factor_entries(const dealii::DynamicSparsityPattern& pattern, const dealii::IndexSet& owned,
+                                           MPI_Comm comm, double limit) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &size);
+  std::vector<std::int64_t> lengths, columns;
+  for (const auto row : owned) {
+    lengths.push_back(static_cast<std::int64_t>(pattern.row_length(row)));
+    for (auto it = pattern.begin(row); it != pattern.end(row); ++it) columns.push_back(static_cast<std::int64_t>(it->column()));
+  }
+  const auto n = static_cast<std::size_t>(owned.size());
+  long long local = static_cast<long long>(columns.size()), total = 0;
+  MPI_Allreduce(&local, &total, 1, MPI_LONG_LONG, MPI_SUM, comm);
+  // L holds at least the lower triangle (n diagonal entries and half the others); the gather below
+  // counts in int.
+  if (0.5 * static_cast<double>(total + static_cast<long long>(n)) > limit || total > std::numeric_limits<int>::max())
+    return std::numeric_limits<double>::infinity();
+  // Rank r's rows follow rank r − 1's (deal.II numbers the processes' DOFs in rank order): each
+  // process's first row says where its rows go.
+  const long long first = owned.n_elements() > 0 ? static_cast<long long>(owned.nth_index_in_set(0)) : -1;
+  const int my_rows = static_cast<int>(lengths.size()), my_entries = static_cast<int>(columns.size());
+  std::vector<long long> firsts(static_cast<std::size_t>(size));
+  std::vector<int> rows(static_cast<std::size_t>(size)), entries(static_cast<std::size_t>(size));
+  MPI_Gather(&first, 1, MPI_LONG_LONG, firsts.data(), 1, MPI_LONG_LONG, 0, comm);
+  MPI_Gather(&my_rows, 1, MPI_INT, rows.data(), 1, MPI_INT, 0, comm);
+  MPI_Gather(&my_entries, 1, MPI_INT, entries.data(), 1, MPI_INT, 0, comm);
+  std::vector<int> row_offset(static_cast<std::size_t>(size), 0), entry_offset(static_cast<std::size_t>(size), 0);
+  std::vector<std::int64_t> all_lengths, all_columns;
+  if (rank == 0) {
+    for (int p = 1; p < size; ++p) {
+      row_offset[static_cast<std::size_t>(p)] = row_offset[static_cast<std::size_t>(p - 1)] + rows[static_cast<std::size_t>(p - 1)];
+      entry_offset[static_cast<std::size_t>(p)] =
+          entry_offset[static_cast<std::size_t>(p - 1)] + entries[static_cast<std::size_t>(p - 1)];
+    }
+    all_lengths.resize(n);
+    all_columns.resize(static_cast<std::size_t>(total));
+  }
+  MPI_Gatherv(lengths.data(), my_rows, MPI_INT64_T, all_lengths.data(), rows.data(), row_offset.data(), MPI_INT64_T, 0, comm);
+  MPI_Gatherv(columns.data(), my_entries, MPI_INT64_T, all_columns.data(), entries.data(), entry_offset.data(), MPI_INT64_T,
+              0, comm);
+  double predicted = -1.0; // -1: the analysis failed on rank 0
+  if (rank == 0) {
+    bool in_order = true;
+    for (int p = 0; p < size; ++p)
+      if (rows[static_cast<std::size_t>(p)] > 0 && firsts[static_cast<std::size_t>(p)] != row_offset[static_cast<std::size_t>(p)])
+        in_order = false;
+    std::vector<std::int64_t> row_start{0};
+    for (const auto l : all_lengths) row_start.push_back(row_start.back() + l);
+    try {
+      if (in_order) predicted = SparseDirect::predict_cholesky_factor_entries(n, row_start, all_columns);
+    } catch (const std::exception&) {
+      predicted = -1.0;
+    }
+  }
+  MPI_Bcast(&predicted, 1, MPI_DOUBLE, 0, comm);
+  if (predicted < 0.0)
+    throw std::runtime_error("finite strain solver: CHOLMOD's analysis of the gathered distributed pattern failed "
+                             "(or the processes' rows are not in rank order)");
+  return predicted;
 }
 
 } // namespace kerf::reference

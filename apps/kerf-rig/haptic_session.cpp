@@ -124,6 +124,10 @@ void run_haptic(const HapticOptions& o) {
   print_histogram("wake lateness", t.lateness);
   print_histogram("period jitter", t.period_jitter);
   print_histogram("model compute", o.model_rate > 0.0 ? report.model_timing.compute : t.compute);
+  std::printf("model steps over budget: %llu reported by the model (not converged in its bounded work), %llu longer than "
+              "their period\n",
+              static_cast<unsigned long long>(report.model_steps_over_budget),
+              static_cast<unsigned long long>(report.model_steps_over_period));
   print_histogram("whole tick", t.tick);
   for (std::size_t i = 0; i < report.links.size(); ++i) {
     const LinkCounters& c = report.links[i];

@@ -56,10 +56,13 @@ ForceProfile reference_profile(const Scene& scene_file, int refine, int samples,
   std::ostringstream cached;
   if (std::ifstream k(dir / "key.txt"); k) cached << k.rdbuf();
   if (cached.str() == key.text && fs::exists(dir / "profile.csv")) return read_profile_csv(dir / "profile.csv");
-  ForceProfile p = finite_element_reference()(scene, spec, refine, indices, dir);
-  if (!fs::exists(dir / "profile.csv")) write_profile_csv(p, dir / "profile.csv");
+  const ReferenceResult r = finite_element_reference()(StudyReferenceSolve{scene, refine, indices, LoadIncrement::whole, dir, key.text}, spec);
+  if (!r.complete())
+    throw std::runtime_error("the reference on " + scene.name + " stopped before the trajectory's end, a fit to it would fit a partial "
+                             "profile: " + r.stopped);
+  if (!fs::exists(dir / "profile.csv")) write_profile_csv(r.profile, dir / "profile.csv");
   write_atomically(dir / "key.txt", [&](const fs::path& tmp) { std::ofstream(tmp) << key.text; });
-  return p;
+  return r.profile;
 }
 
 std::string describe(const CalibratedParameters& p) {

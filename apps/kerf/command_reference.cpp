@@ -8,6 +8,7 @@
 // re-launches the same command under `mpirun -np N` (as `mpirun -np N kerf reference …` does
 // directly): the solver runs distributed.
 
+#include "apps/command_line.hpp"
 #include "apps/kerf/commands.hpp"
 #include "experiments/reference_run/reference_convergence.hpp"
 #include "experiments/reference_run/reference_run.hpp"
@@ -56,8 +57,9 @@ struct ReferenceOptions {
   bool resume = false;
   std::string fracture = "auto";
   std::string mesh = "reference"; ///< "reference": the scene meshed for the reference (graded); "scene": its own mesh
-  double adaptive = 0.05;      ///< adaptive sampling: the force change (fraction of the peak) that inserts a sample; 0: off
+  double adaptive = StudyReferenceSpec{}.adaptive; ///< adaptive sampling: the force change (fraction of the peak) that inserts a sample, a study's default; 0: off
   double min_travel_mm = 0.05; ///< adaptive sampling: the least tool travel between two samples [mm]
+  double vertex_tolerance_mm = ReferenceRunSettings{}.vertex_tolerance * 1e3; ///< the load path's vertices [mm]
   double viscous_time = 0.0; ///< τ [s] of the cohesive law's viscous regularisation (0: none)
   bool dynamic = false;      ///< the dynamic (inertial) step instead of the quasi-static one
   bool no_damping = false;   ///< dynamic step: leave the scene's Kelvin–Voigt damping out
@@ -84,6 +86,9 @@ struct ReferenceOptions {
   if (!o.grasp_element_size.empty()) args.insert(args.end(), {"--grasp-element-size", o.grasp_element_size});
   args.insert(args.end(), {"--fracture", o.fracture, "--mesh", o.mesh});
   args.insert(args.end(), {"--adaptive", std::to_string(o.adaptive), "--min-travel", std::to_string(o.min_travel_mm)});
+  char tolerance[32];
+  std::snprintf(tolerance, sizeof tolerance, "%.17g", o.vertex_tolerance_mm);
+  args.insert(args.end(), {"--vertex-tolerance", tolerance});
   if (o.viscous_time > 0.0) args.insert(args.end(), {"--cohesive-viscous-time", std::to_string(o.viscous_time)});
   if (o.dynamic) args.emplace_back("--dynamic");
   if (o.no_damping) args.emplace_back("--no-damping");
@@ -136,6 +141,7 @@ void run_reference_command(const ReferenceOptions& o) {
   settings.cohesive_viscous_time = o.viscous_time;
   settings.adaptive_force_change = o.samples == "all" ? 0.0 : o.adaptive; // every sample: nothing to insert
   settings.adaptive_min_travel = o.min_travel_mm * 1e-3;
+  settings.vertex_tolerance = o.vertex_tolerance_mm * 1e-3;
   settings.dynamic = o.dynamic;
   settings.damping = !o.no_damping;
   settings.interface_error_relative = o.interface_tolerance;
@@ -178,15 +184,22 @@ void run_reference_command(const ReferenceOptions& o) {
     std::printf("wrote %s, %s\n", (dir / "convergence.csv").c_str(), (dir / "convergence.md").c_str());
     return;
   }
-  const ForceProfile profile = run_reference(scene, mesh, settings, out);
+  const ReferenceResult result = run_reference(scene, mesh, settings, out);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-  if (reference::mpi_processes().rank != 0) return; // rank 0 reports
+  const bool reporter = reference::mpi_processes().rank == 0;
   double peak = 0.0;
-  for (const ProfileRow& r : profile.rows) peak = std::max(peak, r.force.norm());
-  std::printf("%s / reference (P%d, %d refinements): %zu samples solved, peak |F| %.6g N, wall %.2f s\n",
-              scene.name.c_str(), settings.degree, o.refine, profile.rows.size(), peak, wall);
-  std::printf("wrote %s, %s%s\n", (out / "profile.csv").c_str(), (out / "manifest.json").c_str(),
-              settings.write_fields ? (", " + (out / "fields.pvd").string()).c_str() : "");
+  for (const ProfileRow& r : result.profile.rows) peak = std::max(peak, r.force.norm());
+  if (reporter) {
+    std::printf("%s / reference (P%d, %d refinements): %zu samples solved, peak |F| %.6g N, wall %.2f s\n",
+                scene.name.c_str(), settings.degree, o.refine, result.profile.rows.size(), peak, wall);
+    std::printf("wrote %s, %s%s\n", (out / "profile.csv").c_str(), (out / "manifest.json").c_str(),
+                settings.write_fields ? (", " + (out / "fields.pvd").string()).c_str() : "");
+  }
+  // A load path that stopped is no finished reference: the program says so in its status
+  // (apps/command_line.hpp), on every process, after the partial files are written.
+  if (!result.complete())
+    throw IncompleteRun(exit_reference_stopped, "the load path stopped before the trajectory's end (partial profile in " +
+                                                    (out / "profile.csv").string() + "): " + result.stopped);
 }
 
 } // namespace
@@ -237,10 +250,15 @@ void add_reference_command(CLI::App& app) {
   cmd->add_option("--adaptive", options->adaptive,
                   "adaptive sampling: where the force changes by more than this fraction of its peak between two "
                   "samples, or the interaction mode changes (contact, rupture, cutting), solve the sample half way "
-                  "first, down to --min-travel (default 0.05; 0: only the --samples)")
+                  "first, down to --min-travel (default 0.2, as a study's; 0: only the --samples and the trajectory's vertices)")
       ->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--min-travel", options->min_travel_mm,
                   "adaptive sampling: the least tool travel between two samples, in mm (default 0.05)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--vertex-tolerance", options->vertex_tolerance_mm,
+                  "the load path: besides the --samples, every vertex of the tool's motion is solved (a segment's end, "
+                  "a dwell's start and end, a recorded hand's turn): where the motion leaves the straight line in time "
+                  "between its neighbouring vertices by more than this distance, in mm (default 0.001)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--cohesive-viscous-time", options->viscous_time,
                   "viscous regularisation of the cohesive law (Gao & Bower 2004): relaxation time TAU in seconds, "
@@ -248,7 +266,7 @@ void add_reference_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--dynamic", options->dynamic,
                 "dynamic (inertial) step: implicit Newmark average acceleration with the consistent mass of the "
-                "scene's density; the kinetic energy joins the manifest's energy (serial only)");
+                "scene's density; the kinetic energy joins the manifest's energy");
   cmd->add_flag("--no-damping", options->no_damping,
                 "with --dynamic: leave out the scene's Kelvin-Voigt damping (its viscous stress (eta/E) C0 : dE/dt "
                 "and the damping dissipation in the manifest's energy)");

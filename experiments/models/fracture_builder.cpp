@@ -34,6 +34,9 @@ BuiltModel build_fracture_model(const Scene& scene, const TetMesh& mesh) {
   setup.friction = scene.phenomena.contains(Phenomenon::friction);
   setup.friction_coefficient = setup.friction ? scene.material.friction_coefficient : 0.0;
   setup.crack_capture_width = std::max(blade.thickness, 1e-6);
+  // The scene's blade starts on its cutting axis: l(x) along it is tabulated once (a trajectory
+  // or a hand that leaves the axis is measured on the mesh as before).
+  setup.cutting_axis_point = scene.tools.front().trajectory.start;
 
   nlohmann::json p;
   p["edge_direction"] = vector_json(setup.blade.edge_direction);

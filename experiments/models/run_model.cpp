@@ -52,7 +52,7 @@ ForceProfile run_model(ToolModel& model, const std::vector<std::string>& tool_na
   return profile;
 }
 
-CostStatistics cost_statistics(const ForceProfile& profile) {
+std::vector<double> step_costs(const ForceProfile& profile) {
   // Rows of one step share their time and cost: count each step once.
   std::vector<double> costs;
   double last_t = -1.0;
@@ -61,6 +61,10 @@ CostStatistics cost_statistics(const ForceProfile& profile) {
     costs.push_back(r.cost_s);
     last_t = r.t;
   }
+  return costs;
+}
+
+CostStatistics cost_statistics(std::vector<double> costs) {
   CostStatistics s;
   s.steps = costs.size();
   if (costs.empty()) return s;
@@ -72,6 +76,8 @@ CostStatistics cost_statistics(const ForceProfile& profile) {
   s.max = costs.back();
   return s;
 }
+
+CostStatistics cost_statistics(const ForceProfile& profile) { return cost_statistics(step_costs(profile)); }
 
 std::vector<SampledTrajectory> sample_scene_trajectories(const Scene& scene) {
   std::vector<SampledTrajectory> out;

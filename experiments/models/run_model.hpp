@@ -27,6 +27,11 @@ struct CostStatistics {
   [[nodiscard]] double rate_allowed() const { return p99 > 0.0 ? 1.0 / p99 : 0.0; }
 };
 CostStatistics cost_statistics(const ForceProfile& profile);
+/// The cost of each step of a profile [s], in step order (each step counted once).
+std::vector<double> step_costs(const ForceProfile& profile);
+/// Cost statistics of step costs [s] (the nearest-rank median and 99th percentile); `costs` is
+/// reordered.
+CostStatistics cost_statistics(std::vector<double> costs);
 
 /// Samples every tool's trajectory of the scene, in scene order.
 std::vector<SampledTrajectory> sample_scene_trajectories(const Scene& scene);

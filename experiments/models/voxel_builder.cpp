@@ -48,7 +48,8 @@ BuiltModel build_voxel_model(const Scene& scene, const TetMesh& mesh) {
   const VoxelModelSettings& t1 = *scene.voxel;
   // Table 1 in the paper's millimetre unit: E = 20 N/mm^2 as a modulus (Eq. 1's E, with the
   // deformed area Cw dz), the stick's contact stiffness k_e = E x 1 mm = 20 N/mm (the paper's
-  // "material stiffness" E of the DCS), damping 0.5 N s/mm^2 x 1 mm = 0.5 N s/mm.
+  // "material stiffness" E of the DCS), and the damping per unit penetration λ = 0.5 N s/mm^2
+  // (Table 1's own unit: F = λ δ dδ/dt, VoxelCuttingSetup::damping).
   const double modulus = t1.elastic_coefficient / (paper_002_length_unit * paper_002_length_unit);
   const Tool& tool = scene.tools.front();
   VoxelCuttingSetup setup;
@@ -59,7 +60,7 @@ BuiltModel build_voxel_model(const Scene& scene, const TetMesh& mesh) {
     setup.centre_offset = knife_point_stick_offset(tool.blade);
   }
   setup.contact_stiffness = modulus * paper_002_length_unit;
-  setup.damping = t1.damping_coefficient / paper_002_length_unit;
+  setup.damping = t1.damping_coefficient / (paper_002_length_unit * paper_002_length_unit);
   setup.friction_coefficient = t1.friction_coefficient;
   setup.critical_force_depth = t1.critical_force_depth;
   setup.critical_force_cutting = t1.critical_force_cutting;
@@ -76,7 +77,7 @@ BuiltModel build_voxel_model(const Scene& scene, const TetMesh& mesh) {
   p["tool_radius_m"] = setup.tool_radius;
   p["stick_centre_offset_m"] = {setup.centre_offset.x(), setup.centre_offset.y(), setup.centre_offset.z()};
   p["contact_stiffness_N_per_m"] = setup.contact_stiffness;
-  p["damping_N_s_per_m"] = setup.damping;
+  p["damping_N_s_per_m2"] = setup.damping;
   p["friction"] = setup.friction;
   p["friction_coefficient"] = setup.friction_coefficient;
   p["critical_force_depth_N"] = setup.critical_force_depth;

@@ -39,7 +39,7 @@ ConvergenceStudy run_reference_convergence(const Scene& scene, const TetMesh& me
     const auto begin = std::chrono::steady_clock::now();
     ConvergenceLevel level;
     level.refinements = s.refinements;
-    level.profile = run_reference(scene, mesh, s, level_dir);
+    level.profile = run_reference(scene, mesh, s, level_dir).profile;
     level.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     std::ifstream in(level_dir / "manifest.json");
     const nlohmann::json manifest = nlohmann::json::parse(in);

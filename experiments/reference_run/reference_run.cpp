@@ -4,6 +4,7 @@
 #include "experiments/records/content_hash.hpp"
 #include "experiments/scene/scene_mesh.hpp"
 #include "experiments/trajectory/trajectory.hpp"
+#include "experiments/trajectory/trajectory_vertices.hpp"
 #include "meshes/atomic_file.hpp"
 #include "meshes/surface_mesh.hpp"
 #include "reference/load_path.hpp"
@@ -17,6 +18,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <set>
 #include <stdexcept>
@@ -219,341 +221,505 @@ nlohmann::json vec_json(const Eigen::Vector3d& v) { return nlohmann::json::array
 
 } // namespace
 
-ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings,
-                           const std::filesystem::path& dir) {
+namespace {
+
+// ------------------------------------------------------------------------- the load path's targets
+/// Why a trajectory sample is a load of the run (the manifest's `load` of each sample).
+enum class LoadReason { requested, vertex, inserted };
+
+const char* load_reason_name(LoadReason r) {
+  switch (r) {
+  case LoadReason::requested: return "requested";
+  case LoadReason::vertex: return "vertex";
+  case LoadReason::inserted: return "inserted";
+  }
+  return "?";
+}
+
+/// The vertices of the tools' common motion (experiments/trajectory/trajectory_vertices.hpp).
+std::vector<std::size_t> motion_vertices(const ReferenceProblem& rp, double tolerance) {
+  std::vector<SampledTrajectory> motions;
+  for (const ReferenceTool& tool : rp.tools) {
+    SampledTrajectory m;
+    for (std::size_t k = 0; k < rp.times.size(); ++k) {
+      ToolState s;
+      s.time = rp.times[k];
+      s.position = tool.positions[k];
+      m.samples.push_back(s);
+    }
+    motions.push_back(std::move(m));
+  }
+  return trajectory_vertices(motions, tolerance);
+}
+
+/// The loads of a run: the requested output samples and every vertex of the motion up to the last
+/// of them (a run asked to stop early, `kerf reference --until`, ends there), ascending.
+std::vector<std::size_t> planned_loads(const std::vector<std::size_t>& requested, const std::vector<std::size_t>& vertices) {
+  std::vector<std::size_t> out;
+  const auto end = requested.empty() ? vertices.begin() : std::upper_bound(vertices.begin(), vertices.end(), requested.back());
+  std::set_union(requested.begin(), requested.end(), vertices.begin(), end, std::back_inserter(out));
+  return out;
+}
+
+/// A portable path for a manifest: relative to the working directory when the file lies under it
+/// (a study run from the repository root writes `experiments/scenes/…`), else as it is.
+std::string portable_path(const std::filesystem::path& p) {
   namespace fs = std::filesystem;
-  using Clock = std::chrono::steady_clock;
-  const auto wall_begin = Clock::now();
+  std::error_code error;
+  const fs::path base = fs::current_path(error);
+  if (error) return p.string();
+  const fs::path relative = fs::absolute(p, error).lexically_relative(base);
+  if (error || relative.empty() || *relative.begin() == "..") return p.string();
+  return relative.string();
+}
+
+/// The forces and state of one solved sample, as the profile and the manifest record them.
+struct SolvedSample {
+  std::vector<Eigen::Vector3d> tool_forces, tool_positions;
+  Eigen::Vector3d support = Eigen::Vector3d::Zero();
+  nlohmann::json forces_json = nlohmann::json::object();
+  nlohmann::json reactions = nlohmann::json::object();
+  reference::CohesiveSampleState interface;
+  InteractionMode mode = InteractionMode::no_contact;
+  double crack_extent = 0.0;
+};
+
+/// run_reference's steps (reference_run.hpp) over the state they share: the problem, the solver,
+/// the load path along the trajectory, the checkpoint that holds what is solved so far, and the
+/// bookkeeping the manifest reports. run() is the driver; each step below is one idea of it.
+class TrajectorySolve {
+public:
+  TrajectorySolve(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings, std::filesystem::path dir);
+  ReferenceResult run();
+
+private:
+  void plan();
+  void resume_from_checkpoint();
+  reference::LoadPathSettings load_path_settings() const;
+  void start_load_path(const LoadState& from, double interface_step);
+  /// The load at time t on the trajectory: load factor t/T, the pressing tool where it is at t.
+  LoadState load_at(double t) const;
+  SolvedSample forces_of(const reference::LoadStepReport& step, std::size_t k) const;
+  /// Adaptive sampling: whether sample `i` (just solved as `sample`) leaves too fast a change behind
+  /// it, so that the sample half way back must be solved first.
+  bool needs_sample_before(std::size_t i, const SolvedSample& sample) const;
+  void undo_and_insert_before(std::size_t i, const reference::LoadStepReport& step);
+  void record(std::size_t i, const reference::LoadStepReport& step, const SolvedSample& sample);
+  void write_fields_and_checkpoint(std::size_t i, const LoadState& load);
+  void print_progress(std::size_t k, const reference::LoadStepReport& step, const SolvedSample& sample) const;
+  LoadReason reason_of(std::size_t k) const;
+  nlohmann::json manifest(double wall_seconds) const;
+  [[nodiscard]] bool is_tied(const ReferenceTool& t) const { return t.coupling.kind == ReferenceToolCoupling::Kind::tied; }
+
+  const Scene& m_scene;
+  const TetMesh& m_mesh;
+  const ReferenceRunSettings& m_settings;
+  const std::filesystem::path m_dir;
+  ReferenceProblem m_problem;
+  CrackPathInfo m_crack;
+  bool m_damped = false;
+  Eigen::Vector3d m_crack_direction = -Eigen::Vector3d::UnitZ();
+  double m_duration = 0.0; ///< T [s], the trajectory's duration
+  std::vector<std::size_t> m_requested, m_vertices;
+  std::vector<std::size_t> m_indices; ///< the loads to solve: requested ∪ vertices (∪ inserted as they come)
+  reference::SolverSettings m_solver_settings;
+  std::unique_ptr<reference::FiniteStrainSolver> m_solver;
+  bool m_writer = true, m_pieces = false;
+  std::string m_sha;
+  std::filesystem::path m_checkpoint_file;
+  ReferenceCheckpoint m_cp;
+  std::optional<std::size_t> m_resumed_from;
+  std::optional<reference::LoadPath> m_load_path;
+  std::vector<double> m_solved_times;
+  std::string m_stop;
+  std::size_t m_first = 0; ///< samples solved when this run started (after a resume)
+  int m_newton_total = 0;
+  EnergyBookkeeping m_energy;
+  reference::CohesiveSampleState m_previous_interface;
+  double m_peak_force = 0.0;
+  std::size_t m_inserted = 0;
+  std::vector<double> m_state_before; ///< adaptive sampling: the solver state before the sample being solved
+  LoadState m_load_before{};
+  double m_interface_step_before = 0.0;
+  std::chrono::steady_clock::time_point m_begin;
+};
+
+TrajectorySolve::TrajectorySolve(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings,
+                                 std::filesystem::path dir)
+    : m_scene(scene), m_mesh(mesh), m_settings(settings), m_dir(std::move(dir)), m_begin(std::chrono::steady_clock::now()) {
   if (settings.checkpoint_every < 1)
     throw std::invalid_argument("reference: checkpoint_every must be >= 1, got " + std::to_string(settings.checkpoint_every));
-
-  ReferenceProblem rp = reference_problem(scene, mesh);
-  const CrackPathInfo crack = add_crack_path(scene, rp.problem, settings.fracture, settings.refinements,
-                                              settings.cohesive_viscous_time);
-  // Kelvin–Voigt damping: the dynamic step's, when asked for (the quasi-static solve has no rate).
-  bool damped = false;
-  for (reference::MaterialRegion& region : rp.problem.materials) {
-    if (!(settings.dynamic && settings.damping)) region.damping = 0.0;
-    damped = damped || region.damping > 0.0;
-  }
   if (!(settings.interface_error_relative >= 0.0) || !(settings.interface_error_floor >= 0.0) ||
       !std::isfinite(settings.interface_error_relative) || !std::isfinite(settings.interface_error_floor))
     throw std::invalid_argument("reference: the interface energy tolerances must be finite and >= 0, got " +
                                 std::to_string(settings.interface_error_relative) + " and " +
                                 std::to_string(settings.interface_error_floor));
-  if (!crack.warning.empty()) std::fprintf(stderr, "reference %s: warning: %s\n", scene.name.c_str(), crack.warning.c_str());
+  if (settings.adaptive_force_change > 0.0 && !(settings.adaptive_min_travel > 0.0 && std::isfinite(settings.adaptive_force_change)))
+    throw std::invalid_argument("reference: adaptive sampling needs a force change fraction and a minimum travel > 0");
+  m_problem = reference_problem(scene, mesh);
+  m_crack = add_crack_path(scene, m_problem.problem, settings.fracture, settings.refinements, settings.cohesive_viscous_time);
+  // Kelvin–Voigt damping: the dynamic step's, when asked for (the quasi-static solve has no rate).
+  for (reference::MaterialRegion& region : m_problem.problem.materials) {
+    if (!(settings.dynamic && settings.damping)) region.damping = 0.0;
+    m_damped = m_damped || region.damping > 0.0;
+  }
+  if (!m_crack.warning.empty()) std::fprintf(stderr, "reference %s: warning: %s\n", scene.name.c_str(), m_crack.warning.c_str());
   // The crack extent is measured along the blade's cutting direction (c of paper 001 Fig. 3), or
   // downwards from the grasped top for a tear.
-  const Eigen::Vector3d crack_direction =
-      scene.tools.front().kind == Tool::Kind::blade ? scene.tools.front().blade.cutting_direction : Eigen::Vector3d(0, 0, -1);
-  const std::size_t n = rp.times.size();
-  std::vector<std::size_t> indices = settings.sample_indices;
-  if (indices.empty())
-    for (std::size_t k = 0; k < n; ++k) indices.push_back(k);
-  for (std::size_t i = 0; i < indices.size(); ++i)
-    if (indices[i] >= n || (i > 0 && indices[i] <= indices[i - 1]))
+  if (scene.tools.front().kind == Tool::Kind::blade) m_crack_direction = scene.tools.front().blade.cutting_direction;
+  plan();
+  m_solver_settings.degree = settings.degree;
+  m_solver_settings.refinements = settings.refinements;
+  m_solver_settings.linear_solver = settings.linear_solver;
+  m_solver_settings.distribute = settings.distribute;
+  m_solver_settings.residual_fault = settings.residual_fault;
+  m_solver_settings.dynamic = settings.dynamic;
+  m_solver = std::make_unique<reference::FiniteStrainSolver>(m_problem.problem, m_solver_settings);
+  // Under mpirun every process runs this; rank 0 writes the files and the progress. A solver that
+  // is not distributed (settings.distribute false: one of the solves `mpirun kerf study` spreads
+  // over its ranks) is its own process's run, and that process writes.
+  m_writer = m_solver->process_count() == 1 || reference::mpi_processes().rank == 0;
+  m_pieces = m_solver->process_count() > 1;
+  m_sha = file_sha256(scene.file);
+  m_checkpoint_file = m_dir / "checkpoint.bin";
+}
+
+/// The loads: the requested output samples (all when none are named), and the vertices of the
+/// motion, so that between two consecutive loads the tools move along a straight line in time.
+void TrajectorySolve::plan() {
+  const std::size_t n = m_problem.times.size();
+  m_requested = m_settings.sample_indices;
+  if (m_requested.empty())
+    for (std::size_t k = 0; k < n; ++k) m_requested.push_back(k);
+  for (std::size_t i = 0; i < m_requested.size(); ++i)
+    if (m_requested[i] >= n || (i > 0 && m_requested[i] <= m_requested[i - 1]))
       throw std::invalid_argument("reference: sample indices must be ascending and below " + std::to_string(n) +
                                   " (the trajectory's sample count); entry " + std::to_string(i) + " is " +
-                                  std::to_string(indices[i]));
-  const double T = rp.times.back();
-  // The penalty tool, if any, is the scene's only tool (reference_problem).
-  auto load_of = [&](std::size_t k) {
-    return LoadState{T > 0.0 ? rp.times[k] / T : 0.0, rp.tools.front().positions[k], rp.times[k]};
-  };
-  auto is_tied = [](const ReferenceTool& t) { return t.coupling.kind == ReferenceToolCoupling::Kind::tied; };
+                                  std::to_string(m_requested[i]));
+  if (!(m_settings.vertex_tolerance > 0.0) || !std::isfinite(m_settings.vertex_tolerance))
+    throw std::invalid_argument("reference: the vertex tolerance must be a positive length, got " +
+                                std::to_string(m_settings.vertex_tolerance) + " m");
+  m_vertices = motion_vertices(m_problem, m_settings.vertex_tolerance);
+  m_indices = planned_loads(m_requested, m_vertices);
+  m_duration = m_problem.times.back();
+}
 
-  reference::SolverSettings solver_settings;
-  solver_settings.degree = settings.degree;
-  solver_settings.refinements = settings.refinements;
-  solver_settings.linear_solver = settings.linear_solver;
-  solver_settings.distribute = settings.distribute;
-  solver_settings.residual_fault = settings.residual_fault;
-  solver_settings.dynamic = settings.dynamic;
-  reference::FiniteStrainSolver solver(rp.problem, solver_settings);
-  // Under mpirun every process runs this function; rank 0 writes the files and the progress. A
-  // solver that is not distributed (settings.distribute false: e.g. one of the solves `mpirun kerf
-  // study` spreads over its ranks) is its own process's run, and that process writes.
-  const bool writer = solver.process_count() == 1 || reference::mpi_processes().rank == 0;
-  const bool pieces = solver.process_count() > 1;
+LoadState TrajectorySolve::load_at(double t) const {
+  // The pressing tool, if any, is the scene's only tool (reference_problem); a tied tool's
+  // displacement follows the load factor along its own sampled path (tie_stylus).
+  return LoadState{m_duration > 0.0 ? t / m_duration : 0.0, position_at(m_problem.tools.front().positions, m_problem.times, t), t};
+}
 
-  const std::string sha = file_sha256(scene.file);
-  const fs::path checkpoint_file = dir / "checkpoint.bin";
-  ReferenceCheckpoint cp;
-  cp.scene_sha256 = sha;
-  cp.degree = settings.degree;
-  cp.refinements = settings.refinements;
-  cp.processes = solver.process_count();
-  cp.dynamic = settings.dynamic;
-  cp.damped = damped;
-  cp.indices = indices;
-  cp.last = load_of(0);
-  std::optional<std::size_t> resumed_from;
-  if (settings.resume && fs::exists(checkpoint_file)) {
-    ReferenceCheckpoint saved = read_reference_checkpoint(checkpoint_file);
-    // An adaptive run's list grows by the samples it inserted: every requested one must be in it.
-    const bool same_samples = settings.adaptive_force_change > 0.0
-                                  ? std::includes(saved.indices.begin(), saved.indices.end(), indices.begin(), indices.end())
-                                  : saved.indices == indices;
-    if (saved.scene_sha256 != sha || saved.degree != settings.degree || saved.refinements != settings.refinements ||
-        !same_samples || saved.processes != cp.processes)
-      throw std::runtime_error("reference: " + checkpoint_file.string() +
-                               " is from a different run (scene file, degree, refinements, samples or MPI process "
-                               "count differ; it was written by " +
-                               std::to_string(saved.processes) + " process(es), this run has " +
-                               std::to_string(cp.processes) + ")");
-    if (saved.dynamic != cp.dynamic)
-      throw std::runtime_error("reference: " + checkpoint_file.string() + " is from a " +
-                               (saved.dynamic ? "dynamic" : "quasi-static") + " run and this run is " +
-                               (cp.dynamic ? "dynamic (--dynamic)" : "quasi-static") +
-                               ": resume with the same time integration");
-    if (saved.damped != cp.damped)
-      throw std::runtime_error("reference: " + checkpoint_file.string() + " is from a run " +
-                               (saved.damped ? "with" : "without") + " the scene's Kelvin-Voigt damping and this run is " +
-                               (cp.damped ? "damped" : "undamped (--no-damping, or a checkpoint from before the damping)") +
-                               ": resume with the same damping");
-    solver.set_state(saved.state);
-    cp = std::move(saved);
-    indices = cp.indices; // an adaptive run continues with the samples it had inserted
-    cp.last.time = cp.last.load_factor * T; // the load factor is t/T (load_of), also between samples
-    resumed_from = cp.solved;
-    if (writer)
-      std::fprintf(stderr, "reference %s: resuming after sample %zu/%zu from %s\n", scene.name.c_str(), cp.solved,
-                   indices.size(), checkpoint_file.c_str());
-  } else if (settings.resume && writer) {
-    std::fprintf(stderr, "reference %s: no checkpoint in %s, starting from the beginning\n", scene.name.c_str(),
-                 dir.c_str());
+LoadReason TrajectorySolve::reason_of(std::size_t k) const {
+  if (std::binary_search(m_requested.begin(), m_requested.end(), k)) return LoadReason::requested;
+  if (std::binary_search(m_vertices.begin(), m_vertices.end(), k)) return LoadReason::vertex;
+  return LoadReason::inserted;
+}
+
+void TrajectorySolve::resume_from_checkpoint() {
+  namespace fs = std::filesystem;
+  m_cp.scene_sha256 = m_sha;
+  m_cp.degree = m_settings.degree;
+  m_cp.refinements = m_settings.refinements;
+  m_cp.processes = m_solver->process_count();
+  m_cp.dynamic = m_settings.dynamic;
+  m_cp.damped = m_damped;
+  m_cp.indices = m_indices;
+  m_cp.last = load_at(0.0);
+  if (!m_settings.resume) return;
+  if (!fs::exists(m_checkpoint_file)) {
+    if (m_writer)
+      std::fprintf(stderr, "reference %s: no checkpoint in %s, starting from the beginning\n", m_scene.name.c_str(), m_dir.c_str());
+    return;
   }
-  if (settings.write_fields) fs::create_directories(dir / "fields");
+  ReferenceCheckpoint saved = read_reference_checkpoint(m_checkpoint_file);
+  // An adaptive run's list grows by the samples it inserted: every planned one must be in it.
+  const bool same_samples = m_settings.adaptive_force_change > 0.0
+                                ? std::includes(saved.indices.begin(), saved.indices.end(), m_indices.begin(), m_indices.end())
+                                : saved.indices == m_indices;
+  if (saved.scene_sha256 != m_sha || saved.degree != m_settings.degree || saved.refinements != m_settings.refinements ||
+      !same_samples || saved.processes != m_cp.processes)
+    throw std::runtime_error("reference: " + m_checkpoint_file.string() +
+                             " is from a different run (scene file, degree, refinements, loads or MPI process "
+                             "count differ; it was written by " +
+                             std::to_string(saved.processes) + " process(es), this run has " +
+                             std::to_string(m_cp.processes) + ")");
+  if (saved.dynamic != m_cp.dynamic)
+    throw std::runtime_error("reference: " + m_checkpoint_file.string() + " is from a " +
+                             (saved.dynamic ? "dynamic" : "quasi-static") + " run and this run is " +
+                             (m_cp.dynamic ? "dynamic (--dynamic)" : "quasi-static") + ": resume with the same time integration");
+  if (saved.damped != m_cp.damped)
+    throw std::runtime_error("reference: " + m_checkpoint_file.string() + " is from a run " +
+                             (saved.damped ? "with" : "without") + " the scene's Kelvin-Voigt damping and this run is " +
+                             (m_cp.damped ? "damped" : "undamped (--no-damping, or a checkpoint from before the damping)") +
+                             ": resume with the same damping");
+  m_solver->set_state(saved.state);
+  m_cp = std::move(saved);
+  m_indices = m_cp.indices; // an adaptive run continues with the samples it had inserted
+  m_cp.last.time = m_cp.last.load_factor * m_duration; // the load factor is t/T (load_at), also between samples
+  m_resumed_from = m_cp.solved;
+  if (m_writer)
+    std::fprintf(stderr, "reference %s: resuming after sample %zu/%zu from %s\n", m_scene.name.c_str(), m_cp.solved,
+                 m_indices.size(), m_checkpoint_file.c_str());
+}
 
-  reference::LoadPathSettings path_settings;
-  if (settings.dynamic && crack.active) {
+reference::LoadPathSettings TrajectorySolve::load_path_settings() const {
+  reference::LoadPathSettings s;
+  if (m_settings.dynamic && m_crack.active) {
     // The interface energy control (reference/load_path.hpp): |e| <= rel ΔD + floor J_c A per step.
-    path_settings.interface_error_relative = settings.interface_error_relative;
-    path_settings.interface_error_absolute =
-        settings.interface_error_floor * scene.material.fracture_toughness * crack.interface_area;
+    s.interface_error_relative = m_settings.interface_error_relative;
+    s.interface_error_absolute = m_settings.interface_error_floor * m_scene.material.fracture_toughness * m_crack.interface_area;
   }
-  // In an optional: adaptive sampling rebuilds it at an earlier converged state (it holds the solver).
-  std::optional<reference::LoadPath> load_path;
-  load_path.emplace(solver, cp.last, path_settings);
-  load_path->set_interface_step(cp.interface_step);
-  std::vector<double> solved_times;
-  for (std::size_t k : indices) solved_times.push_back(rp.times[k]);
-  std::string stop;
-  const auto run_begin = Clock::now();
-  const std::size_t first = cp.solved;
-  int newton_total = 0;
-  for (const auto& s : cp.samples) newton_total += s.at("newton_iterations").get<int>();
-  // Energy bookkeeping and the interface state of the previous sample (for the modes), restored
-  // from the last sample record on resume.
-  EnergyBookkeeping energy;
-  reference::CohesiveSampleState previous_interface;
-  if (!cp.samples.empty() && cp.samples.back().contains("energy")) {
-    energy = EnergyBookkeeping::from_json(cp.samples.back().at("energy"));
-    previous_interface = {cp.samples.back().at("contact_points").get<int>() > 0, cp.samples.back().at("energy").at("failed_area_m2").get<double>()};
+  return s;
+}
+
+void TrajectorySolve::start_load_path(const LoadState& from, double interface_step) {
+  m_load_path.emplace(*m_solver, from, load_path_settings(), [this](double t) { return load_at(t); });
+  m_load_path->set_interface_step(interface_step);
+}
+
+SolvedSample TrajectorySolve::forces_of(const reference::LoadStepReport& step, std::size_t k) const {
+  SolvedSample out;
+  for (const reference::BoundaryReaction& b : step.equilibrium.boundary_reactions)
+    out.reactions[b.surface] = vec_json(b.force + Eigen::Vector3d::Zero());
+  // The force on each tool: a tied stylus's is the reaction of its tie (the force of the body on
+  // the tied nodes); a pressing tool's is the contact resultant. The supports carry the rest.
+  out.support = step.support_reaction;
+  bool touching = false;
+  for (const ReferenceTool& tool : m_problem.tools) {
+    Eigen::Vector3d f = step.tool_force;
+    bool touches = step.equilibrium.contact_points + step.equilibrium.edge_contact_points > 0;
+    if (is_tied(tool) && tool.coupling.foundation >= 0) {
+      // A compliant grasp: the force of the body on its layer, −∫ k (d − u) dA (not a support).
+      f = step.equilibrium.foundation_forces.at(static_cast<std::size_t>(tool.coupling.foundation));
+      touches = f.norm() > 0.0;
+    } else if (is_tied(tool)) {
+      f = step.equilibrium.boundary_reactions.at(static_cast<std::size_t>(tool.coupling.boundary)).force;
+      out.support -= f;
+      touches = f.norm() > 0.0;
+    }
+    f += Eigen::Vector3d::Zero(); // −0 → 0 in the CSV
+    touching = touching || touches;
+    out.tool_forces.push_back(f);
+    out.tool_positions.push_back(tool.positions[k]);
+    out.forces_json[tool.name] = vec_json(f);
   }
-  // Adaptive sampling: the state before each sample, to undo it when an intermediate sample is due.
-  const bool adaptive = settings.adaptive_force_change > 0.0;
-  if (adaptive && !(settings.adaptive_min_travel > 0.0 && std::isfinite(settings.adaptive_force_change)))
-    throw std::invalid_argument("reference: adaptive sampling needs a force change fraction and a minimum travel > 0");
-  double peak_force = 0.0;
-  for (const ProfileRow& r : cp.profile.rows) peak_force = std::max(peak_force, r.force.norm());
-  auto travel_between = [&](std::size_t a, std::size_t b) {
-    double d = 0.0;
-    for (const ReferenceTool& tool : rp.tools) d = std::max(d, (tool.positions[b] - tool.positions[a]).norm());
-    return d;
-  };
-  std::size_t inserted = 0;
-  for (std::size_t i = cp.solved; i < indices.size(); ++i) {
-    const std::size_t k = indices[i];
-    reference::LoadStepReport step;
-    const LoadState load = load_of(k);
-    std::vector<double> state_before;
-    LoadState load_before{};
-    double interface_step_before = 0.0;
-    if (adaptive && i > 0) {
-      state_before = load_path->last_converged_state();
-      load_before = load_path->last_converged_load();
-      interface_step_before = load_path->interface_step();
-    }
-    try {
-      step = load_path->advance({load, k, rp.times[k]});
-    } catch (const reference::LoadPathError& e) {
-      stop = e.what();
-      if (writer) std::fprintf(stderr, "reference %s: stopped: %s\n", scene.name.c_str(), e.what());
-      break;
-    }
-    const double cost = step.seconds;
-    nlohmann::json reactions = nlohmann::json::object();
-    for (const reference::BoundaryReaction& b : step.equilibrium.boundary_reactions)
-      reactions[b.surface] = vec_json(b.force + Eigen::Vector3d::Zero());
-    // The force on each tool: a tied stylus's is the reaction of its tie (the force of the body on
-    // the tied nodes); a pressing tool's is the contact resultant. The supports carry the rest.
-    std::vector<Eigen::Vector3d> tool_forces, tool_positions, forces_on_body;
-    Eigen::Vector3d support = step.support_reaction;
-    bool touching = false;
-    nlohmann::json forces_json = nlohmann::json::object();
-    for (const ReferenceTool& tool : rp.tools) {
-      Eigen::Vector3d f = step.tool_force;
-      bool touches = step.equilibrium.contact_points + step.equilibrium.edge_contact_points > 0;
-      if (is_tied(tool) && tool.coupling.foundation >= 0) {
-        // A compliant grasp: the force of the body on its layer, −∫ k (d − u) dA (not a support).
-        f = step.equilibrium.foundation_forces.at(static_cast<std::size_t>(tool.coupling.foundation));
-        touches = f.norm() > 0.0;
-      } else if (is_tied(tool)) {
-        f = step.equilibrium.boundary_reactions.at(static_cast<std::size_t>(tool.coupling.boundary)).force;
-        support -= f;
-        touches = f.norm() > 0.0;
-      }
-      f += Eigen::Vector3d::Zero(); // −0 → 0 in the CSV
-      touching = touching || touches;
-      tool_forces.push_back(f);
-      tool_positions.push_back(tool.positions[k]);
-      forces_on_body.push_back(-f);
-      forces_json[tool.name] = vec_json(f);
-    }
-    const reference::CohesiveSampleState interface{touching, step.equilibrium.cohesive.failed_area};
-    InteractionMode mode = touching ? InteractionMode::deformation_1 : InteractionMode::no_contact;
-    double crack_extent = 0.0;
-    if (crack.active) {
-      mode = reference::reference_mode(previous_interface, interface);
-      crack_extent = solver.crack_extent(crack_direction);
-    }
-    if (adaptive && i > 0) {
-      // An event or a fast change between the previous sample and this one: undo this sample and
-      // solve the one half way first (while the tool travels more than the minimum between them).
-      const std::size_t previous = indices[i - 1];
-      const std::size_t n_tools = rp.tools.size();
-      const std::size_t last = cp.profile.rows.size() - n_tools; // the previous sample's first row
-      const ProfileRow& before = cp.profile.rows[last];
-      // A fast change is a curve that leaves the straight line through the two samples before:
-      // |F_k − (F_{k−1} + (F_{k−1} − F_{k−2}) (t_k − t_{k−1}) / (t_{k−1} − t_{k−2}))| beyond the
-      // fraction of the largest force (a ramp from zero is straight: it inserts nothing).
-      double deviation = 0.0;
-      if (i > 1) {
-        const std::size_t older = last - n_tools;
-        const double t0 = cp.profile.rows[older].t, t1 = before.t, t2 = rp.times[k];
-        const double slope = t1 > t0 ? (t2 - t1) / (t1 - t0) : 0.0;
-        for (std::size_t j = 0; j < n_tools; ++j) {
-          const Eigen::Vector3d& f0 = cp.profile.rows[older + j].force;
-          const Eigen::Vector3d& f1 = cp.profile.rows[last + j].force;
-          deviation = std::max(deviation, (tool_forces[j] - (f1 + (f1 - f0) * slope)).norm());
-        }
-      }
-      const double scale = std::max({peak_force, tool_forces.front().norm(), before.force.norm()});
-      const bool event = mode != before.mode;
-      const bool fast = deviation > settings.adaptive_force_change * scale;
-      if ((event || fast) && k > previous + 1 && travel_between(previous, k) > settings.adaptive_min_travel) {
-        cp.solve_seconds += step.seconds; // the undone solve's cost is spent all the same
-        newton_total += step.newton_iterations;
-        solver.set_state(state_before);
-        load_path.emplace(solver, load_before, path_settings);
-        load_path->set_interface_step(interface_step_before);
-        indices.insert(indices.begin() + static_cast<std::ptrdiff_t>(i), previous + (k - previous) / 2);
-        solved_times.insert(solved_times.begin() + static_cast<std::ptrdiff_t>(i), rp.times[indices[i]]);
-        cp.indices = indices;
-        ++inserted;
-        --i; // the loop's ++i comes back to position i: the inserted sample
-        continue;
-      }
-    }
-    for (const Eigen::Vector3d& f : tool_forces) peak_force = std::max(peak_force, f.norm());
-    previous_interface = interface;
-    energy.add_sample(tool_positions, forces_on_body, solver.strain_energy(), step.equilibrium.cohesive,
-                      step.equilibrium.contact_energy + step.equilibrium.foundation_energy, solver.kinetic_energy(), solver.damping_dissipation());
-    for (std::size_t j = 0; j < rp.tools.size(); ++j) {
-      ProfileRow row;
-      row.t = rp.times[k];
-      row.tool = rp.tools[j].name;
-      row.position = tool_positions[j];
-      row.force = tool_forces[j];
-      row.mode = mode;
-      row.crack_extent = crack_extent;
-      row.cost_s = cost; // one solve for all the tools
-      cp.profile.rows.push_back(row);
-    }
-    const Eigen::Vector3d& tool_force = tool_forces.front();
-    cp.samples.push_back({{"index", k},
-                          {"t_s", rp.times[k]},
+  out.interface = {touching, step.equilibrium.cohesive.failed_area};
+  out.mode = touching ? InteractionMode::deformation_1 : InteractionMode::no_contact;
+  if (m_crack.active) {
+    out.mode = reference::reference_mode(m_previous_interface, out.interface);
+    out.crack_extent = m_solver->crack_extent(m_crack_direction);
+  }
+  return out;
+}
+
+bool TrajectorySolve::needs_sample_before(std::size_t i, const SolvedSample& sample) const {
+  if (!(m_settings.adaptive_force_change > 0.0) || i == 0) return false;
+  const std::size_t k = m_indices[i], previous = m_indices[i - 1];
+  double travel = 0.0;
+  for (const ReferenceTool& tool : m_problem.tools) travel = std::max(travel, (tool.positions[k] - tool.positions[previous]).norm());
+  if (k <= previous + 1 || travel <= m_settings.adaptive_min_travel) return false;
+  const std::size_t n_tools = m_problem.tools.size();
+  const std::vector<ProfileRow>& rows = m_cp.profile.rows;
+  const std::size_t last = rows.size() - n_tools; // the previous sample's first row
+  const ProfileRow& before = rows[last];
+  if (sample.mode != before.mode) return true; // an event: first contact, rupture, cutting, release
+  // A fast change is a curve that leaves the straight line through the two samples before:
+  // |F_k − (F_{k−1} + (F_{k−1} − F_{k−2}) (t_k − t_{k−1}) / (t_{k−1} − t_{k−2}))| beyond the
+  // fraction of the largest force (a ramp from zero is straight: it inserts nothing).
+  if (i < 2) return false;
+  const std::size_t older = last - n_tools;
+  const double t0 = rows[older].t, t1 = before.t, t2 = m_problem.times[k];
+  const double slope = t1 > t0 ? (t2 - t1) / (t1 - t0) : 0.0;
+  double deviation = 0.0;
+  for (std::size_t j = 0; j < n_tools; ++j) {
+    const Eigen::Vector3d& f0 = rows[older + j].force;
+    const Eigen::Vector3d& f1 = rows[last + j].force;
+    deviation = std::max(deviation, (sample.tool_forces[j] - (f1 + (f1 - f0) * slope)).norm());
+  }
+  const double scale = std::max({m_peak_force, sample.tool_forces.front().norm(), before.force.norm()});
+  return deviation > m_settings.adaptive_force_change * scale;
+}
+
+void TrajectorySolve::undo_and_insert_before(std::size_t i, const reference::LoadStepReport& step) {
+  m_cp.solve_seconds += step.seconds; // the undone solve's cost is spent all the same
+  m_newton_total += step.newton_iterations;
+  // Back to the previous sample's state (the one the load path held before this sample).
+  m_solver->set_state(m_state_before);
+  start_load_path(m_load_before, m_interface_step_before);
+  const std::size_t previous = m_indices[i - 1], k = m_indices[i];
+  m_indices.insert(m_indices.begin() + static_cast<std::ptrdiff_t>(i), previous + (k - previous) / 2);
+  m_solved_times.insert(m_solved_times.begin() + static_cast<std::ptrdiff_t>(i), m_problem.times[m_indices[i]]);
+  m_cp.indices = m_indices;
+  ++m_inserted;
+}
+
+void TrajectorySolve::record(std::size_t i, const reference::LoadStepReport& step, const SolvedSample& sample) {
+  const std::size_t k = m_indices[i];
+  for (const Eigen::Vector3d& f : sample.tool_forces) m_peak_force = std::max(m_peak_force, f.norm());
+  m_previous_interface = sample.interface;
+  std::vector<Eigen::Vector3d> forces_on_body;
+  for (const Eigen::Vector3d& f : sample.tool_forces) forces_on_body.push_back(-f);
+  m_energy.add_sample(sample.tool_positions, forces_on_body, m_solver->strain_energy(), step.equilibrium.cohesive,
+                      step.equilibrium.contact_energy + step.equilibrium.foundation_energy, m_solver->kinetic_energy(),
+                      m_solver->damping_dissipation());
+  for (std::size_t j = 0; j < m_problem.tools.size(); ++j) {
+    ProfileRow row;
+    row.t = m_problem.times[k];
+    row.tool = m_problem.tools[j].name;
+    row.position = sample.tool_positions[j];
+    row.force = sample.tool_forces[j];
+    row.mode = sample.mode;
+    row.crack_extent = sample.crack_extent;
+    row.cost_s = step.seconds; // one solve for all the tools
+    m_cp.profile.rows.push_back(row);
+  }
+  m_cp.samples.push_back({{"index", k},
+                          {"t_s", m_problem.times[k]},
+                          {"load", load_reason_name(reason_of(k))},
                           {"newton_iterations", step.newton_iterations},
                           {"cutbacks", step.cutbacks},
                           {"increments", step.increments},
                           {"interface_rejections", step.interface_rejections},
                           {"interface_tolerance_exceeded", step.interface_tolerance_exceeded},
                           {"residual_N", step.final_residual},
-                          {"seconds", cost},
-                          {"tool_force_N", vec_json(tool_force)},
-                          {"tool_forces_N", forces_json},
-                          {"support_reaction_N", vec_json(support)},
-                          {"boundary_reactions_N", reactions},
+                          {"seconds", step.seconds},
+                          {"tool_force_N", vec_json(sample.tool_forces.front())},
+                          {"tool_forces_N", sample.forces_json},
+                          {"support_reaction_N", vec_json(sample.support)},
+                          {"boundary_reactions_N", sample.reactions},
                           {"force_imbalance_N", vec_json(step.equilibrium.force_imbalance)},
                           {"contact_points", step.equilibrium.contact_points},
                           {"edge_contact_points", step.equilibrium.edge_contact_points},
                           {"edge_contact_length_m", step.equilibrium.edge_contact_length},
-                          {"energy", energy.to_json()}});
-    cp.solve_seconds += cost;
-    newton_total += step.newton_iterations;
-    cp.solved = i + 1;
-    cp.last = load_path->last_converged_load();
-    cp.interface_step = load_path->interface_step();
-    if (settings.write_fields) {
-      if (pieces)
-        solver.write_fields(dir / "fields" / step_name(i, true), load); // collective; atomic inside
-      else if (writer)
-        write_atomically(dir / "fields" / step_name(i, false), [&](const fs::path& tmp) { solver.write_fields(tmp, load); });
-      if (writer) write_pvd(dir, solved_times, cp.solved, pieces);
-    }
-    if (cp.solved % static_cast<std::size_t>(settings.checkpoint_every) == 0) {
-      cp.state = load_path->last_converged_state();
-      if (writer) write_reference_checkpoint(cp, checkpoint_file);
-    }
-    const double elapsed = std::chrono::duration<double>(Clock::now() - run_begin).count();
-    const double eta = elapsed / static_cast<double>(cp.solved - first) * static_cast<double>(indices.size() - cp.solved);
-    if (writer)
-      std::fprintf(stderr,
-                   "reference %s: sample %zu/%zu (#%zu, t = %.4f s) tool (%.3f, %.3f, %.3f) mm, %d Newton its, "
-                   "%d cut-backs, |R| %.2e N, |F| %.4g N, elapsed %.1f s, ETA %.1f s\n",
-                   scene.name.c_str(), cp.solved, indices.size(), k, rp.times[k], tool_positions.front().x() * 1e3,
-                   tool_positions.front().y() * 1e3, tool_positions.front().z() * 1e3, step.newton_iterations, step.cutbacks,
-                   step.final_residual, tool_force.norm(), elapsed, eta);
-  }
-  if (!stop.empty()) {
-    cp.state = load_path->last_converged_state();
-    if (writer) write_reference_checkpoint(cp, checkpoint_file); // the last converged state, saved
-  }
+                          {"energy", m_energy.to_json()}});
+  m_cp.solve_seconds += step.seconds;
+  m_newton_total += step.newton_iterations;
+  m_cp.solved = i + 1;
+  m_cp.last = m_load_path->last_converged_load();
+  m_cp.interface_step = m_load_path->interface_step();
+}
 
+void TrajectorySolve::write_fields_and_checkpoint(std::size_t i, const LoadState& load) {
+  namespace fs = std::filesystem;
+  if (m_settings.write_fields) {
+    if (m_pieces)
+      m_solver->write_fields(m_dir / "fields" / step_name(i, true), load); // collective; atomic inside
+    else if (m_writer)
+      write_atomically(m_dir / "fields" / step_name(i, false), [&](const fs::path& tmp) { m_solver->write_fields(tmp, load); });
+    if (m_writer) write_pvd(m_dir, m_solved_times, m_cp.solved, m_pieces);
+  }
+  if (m_cp.solved % static_cast<std::size_t>(m_settings.checkpoint_every) == 0) {
+    m_cp.state = m_load_path->last_converged_state();
+    if (m_writer) write_reference_checkpoint(m_cp, m_checkpoint_file);
+  }
+}
+
+void TrajectorySolve::print_progress(std::size_t k, const reference::LoadStepReport& step, const SolvedSample& sample) const {
+  if (!m_writer) return;
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_begin).count();
+  const double eta = elapsed / static_cast<double>(m_cp.solved - m_first) * static_cast<double>(m_indices.size() - m_cp.solved);
+  const Eigen::Vector3d& x = sample.tool_positions.front();
+  std::fprintf(stderr,
+               "reference %s: sample %zu/%zu (#%zu, t = %.4f s, %s) tool (%.3f, %.3f, %.3f) mm, %d Newton its, "
+               "%d cut-backs, |R| %.2e N, |F| %.4g N, elapsed %.1f s, ETA %.1f s\n",
+               m_scene.name.c_str(), m_cp.solved, m_indices.size(), k, m_problem.times[k], load_reason_name(reason_of(k)),
+               x.x() * 1e3, x.y() * 1e3, x.z() * 1e3, step.newton_iterations, step.cutbacks, step.final_residual,
+               sample.tool_forces.front().norm(), elapsed, eta);
+}
+
+ReferenceResult TrajectorySolve::run() {
+  namespace fs = std::filesystem;
+  resume_from_checkpoint();
+  if (m_settings.write_fields) fs::create_directories(m_dir / "fields");
+  start_load_path(m_cp.last, m_cp.interface_step);
+  for (std::size_t k : m_indices) m_solved_times.push_back(m_problem.times[k]);
+  m_first = m_cp.solved;
+  for (const auto& s : m_cp.samples) m_newton_total += s.at("newton_iterations").get<int>();
+  // Energy bookkeeping and the interface state of the previous sample (for the modes), restored
+  // from the last sample record on resume.
+  if (!m_cp.samples.empty() && m_cp.samples.back().contains("energy")) {
+    m_energy = EnergyBookkeeping::from_json(m_cp.samples.back().at("energy"));
+    m_previous_interface = {m_cp.samples.back().at("contact_points").get<int>() > 0,
+                            m_cp.samples.back().at("energy").at("failed_area_m2").get<double>()};
+  }
+  for (const ProfileRow& r : m_cp.profile.rows) m_peak_force = std::max(m_peak_force, r.force.norm());
+
+  for (std::size_t i = m_cp.solved; i < m_indices.size(); ++i) {
+    const std::size_t k = m_indices[i];
+    const LoadState load = load_at(m_problem.times[k]);
+    if (m_settings.adaptive_force_change > 0.0) {
+      // The state before this sample: adaptive sampling returns to it to solve a sample before this one.
+      m_state_before = m_load_path->last_converged_state();
+      m_load_before = m_load_path->last_converged_load();
+      m_interface_step_before = m_load_path->interface_step();
+    }
+    reference::LoadStepReport step;
+    try {
+      step = m_load_path->advance({load, k, m_problem.times[k]});
+    } catch (const reference::LoadPathError& e) {
+      m_stop = e.what();
+      if (m_writer) std::fprintf(stderr, "reference %s: stopped: %s\n", m_scene.name.c_str(), e.what());
+      break;
+    }
+    const SolvedSample sample = forces_of(step, k);
+    if (needs_sample_before(i, sample)) {
+      undo_and_insert_before(i, step);
+      --i; // the loop's ++i comes back to position i: the inserted sample
+      continue;
+    }
+    record(i, step, sample);
+    write_fields_and_checkpoint(i, load);
+    print_progress(k, step, sample);
+  }
+  if (!m_stop.empty()) {
+    m_cp.state = m_load_path->last_converged_state();
+    if (m_writer) write_reference_checkpoint(m_cp, m_checkpoint_file); // the last converged state, saved
+  }
+  const nlohmann::json m = manifest(std::chrono::duration<double>(std::chrono::steady_clock::now() - m_begin).count());
+  if (m_writer) {
+    write_profile_csv(m_cp.profile, m_dir / "profile.csv");
+    write_manifest(m, m_dir / "manifest.json");
+  }
+  reference::wait_for_processes(); // the files are in place when any process returns
+  return {m_cp.profile, m_stop};
+}
+
+nlohmann::json TrajectorySolve::manifest(double wall_seconds) const {
   nlohmann::json m;
   m["kerf_version"] = KERF_VERSION;
   m["git_commit"] = KERF_GIT_COMMIT;
-  m["scene"] = {{"name", scene.name},
-                {"file", fs::absolute(scene.file).string()},
-                {"sha256", sha},
-                {"phenomena", scene.phenomena.to_string()}};
+  m["scene"] = {{"name", m_scene.name},
+                {"file", portable_path(m_scene.file)},
+                {"sha256", m_sha},
+                {"phenomena", m_scene.phenomena.to_string()}};
   m["model"] = {{"name", "reference"},
                 {"parameters",
-                 {{"degree", settings.degree},
-                  {"refinements", settings.refinements},
-                  {"samples_requested", indices.size()},
-                  {"checkpoint_every", settings.checkpoint_every},
-                  {"time_integration", settings.dynamic ? "dynamic: Newmark average acceleration (beta = 1/4, gamma = 1/2), consistent mass"
-                                                        : "quasi-static"},
-                  {"kelvin_voigt_damping", damped},
-                  {"interface_error_relative", path_settings.interface_error_relative},
-                  {"interface_error_absolute_J", path_settings.interface_error_absolute},
-                  {"write_fields", settings.write_fields}}}};
-  m["mesh"] = {{"nodes", mesh.nodes.rows()},
-               {"tetrahedra", mesh.tets.rows()},
-               {"element_size_m", scene.geometry.element_size},
-               {"source", scene.geometry.source.string()}};
-  nlohmann::json solver_json = {{"dofs", solver.dof_count()},
-                                {"cells", solver.cell_count()},
-                                {"linear_solver", solver.linear_solver_name()},
-                                {"mpi_processes", solver.process_count()},
-                                {"relative_tolerance", solver_settings.relative_tolerance},
-                                {"max_newton_iterations", solver_settings.max_newton_iterations},
-                                {"max_cutbacks", reference::LoadPathSettings{}.max_cutbacks},
-                                {"tool_coupling", is_tied(rp.tools.front()) ? "tied" : "penalty"}};
-  nlohmann::json tools_json = nlohmann::json::array();
-  for (const ReferenceTool& tool : rp.tools) {
+                 {{"degree", m_settings.degree},
+                  {"refinements", m_settings.refinements},
+                  {"samples_requested", m_requested.size()},
+                  {"checkpoint_every", m_settings.checkpoint_every},
+                  {"time_integration", m_settings.dynamic ? "dynamic: Newmark average acceleration (beta = 1/4, gamma = 1/2), consistent mass"
+                                                          : "quasi-static"},
+                  {"kelvin_voigt_damping", m_damped},
+                  {"interface_error_relative", load_path_settings().interface_error_relative},
+                  {"interface_error_absolute_J", load_path_settings().interface_error_absolute},
+                  {"write_fields", m_settings.write_fields}}}};
+  m["mesh"] = {{"nodes", m_mesh.nodes.rows()},
+               {"tetrahedra", m_mesh.tets.rows()},
+               {"element_size_m", m_scene.geometry.element_size},
+               {"source", portable_path(m_scene.geometry.source)}};
+  nlohmann::json solver = {{"dofs", m_solver->dof_count()},
+                           {"cells", m_solver->cell_count()},
+                           {"linear_solver", m_solver->linear_solver_name()},
+                           {"linear_solver_reason", m_solver->linear_solver_reason()},
+                           {"mpi_processes", m_solver->process_count()},
+                           {"relative_tolerance", m_solver_settings.relative_tolerance},
+                           {"max_newton_iterations", m_solver_settings.max_newton_iterations},
+                           {"max_cutbacks", reference::LoadPathSettings{}.max_cutbacks},
+                           {"tool_coupling", is_tied(m_problem.tools.front()) ? "tied" : "penalty"}};
+  nlohmann::json tools = nlohmann::json::array();
+  for (const ReferenceTool& tool : m_problem.tools) {
     nlohmann::json t = {{"name", tool.name}, {"coupling", is_tied(tool) ? "tied" : "penalty"}};
     if (is_tied(tool)) {
       t["tied_nodes"] = tool.coupling.tied_nodes;
@@ -561,48 +727,72 @@ ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const Refere
       if (tool.coupling.foundation >= 0) t["grasp_stiffness_N_per_m3"] = tool.coupling.grasp_stiffness;
       t["contact_point_m"] = vec_json(tool.coupling.contact_point);
     }
-    tools_json.push_back(t);
+    tools.push_back(t);
   }
-  solver_json["tools"] = tools_json;
-  if (adaptive)
-    solver_json["adaptive_sampling"] = {{"force_change", settings.adaptive_force_change},
-                                        {"min_travel_m", settings.adaptive_min_travel},
-                                        {"requested_samples", settings.sample_indices.size()},
-                                        {"solved_samples", indices.size()},
-                                        {"inserted_this_run", inserted}};
-  if (is_tied(rp.tools.front())) { // the first tool's, as before several tools were coupled
-    solver_json["tied_nodes"] = rp.tools.front().coupling.tied_nodes;
-    solver_json["tied_triangles"] = rp.tools.front().coupling.tied_triangles.size();
-    solver_json["contact_point_m"] = vec_json(rp.tools.front().coupling.contact_point);
+  solver["tools"] = tools;
+  // The load path: every vertex of the motion, the requested samples, the ones adaptive sampling
+  // inserted; between two loads the tools move along the trajectory (LoadPath's motion).
+  std::size_t vertices_solved = 0, inserted_solved = 0;
+  for (std::size_t i = 0; i < m_cp.solved; ++i) {
+    const LoadReason r = reason_of(m_indices[i]);
+    vertices_solved += r == LoadReason::vertex;
+    inserted_solved += r == LoadReason::inserted;
+  }
+  solver["load_path"] = {{"motion", "the trajectory: between two loads the tools move along it (reference/load_path.hpp)"},
+                         {"vertex_tolerance_m", m_settings.vertex_tolerance},
+                         {"requested_samples", m_requested.size()},
+                         {"vertices", m_vertices.size()},
+                         {"loads_planned", m_indices.size()},
+                         {"loads_solved", m_cp.solved},
+                         {"vertices_not_requested", vertices_solved},
+                         {"inserted", inserted_solved}};
+  if (m_settings.adaptive_force_change > 0.0)
+    solver["adaptive_sampling"] = {{"force_change", m_settings.adaptive_force_change},
+                                   {"min_travel_m", m_settings.adaptive_min_travel},
+                                   {"requested_samples", m_settings.sample_indices.size()},
+                                   {"solved_samples", m_indices.size()},
+                                   {"inserted_this_run", m_inserted}};
+  if (is_tied(m_problem.tools.front())) { // the first tool's, as before several tools were coupled
+    solver["tied_nodes"] = m_problem.tools.front().coupling.tied_nodes;
+    solver["tied_triangles"] = m_problem.tools.front().coupling.tied_triangles.size();
+    solver["contact_point_m"] = vec_json(m_problem.tools.front().coupling.contact_point);
   } else {
-    solver_json["contact_penalty_Pa_per_m"] = solver.contact_penalty();
+    solver["contact_penalty_Pa_per_m"] = m_solver->contact_penalty();
   }
-  m["solver"] = solver_json;
-  m["timings"] = {{"wall_s", std::chrono::duration<double>(Clock::now() - wall_begin).count()},
-                  {"solve_total_s", cp.solve_seconds},
-                  {"samples_solved", cp.solved}};
-  m["newton_iterations_total"] = newton_total;
-  m["energy"] = energy.to_json();
-  m["fracture"] = crack.active ? nlohmann::json{{"cohesive_law", "bilinear (Camacho-Ortiz effective opening), reference/cohesive/cohesive_law.hpp"},
-                                                {"cohesive_strength_Pa", scene.material.cohesive_strength},
-                                                {"fracture_toughness_J_per_m2", scene.material.fracture_toughness},
-                                                {"interface_triangles", crack.interface_triangles},
-                                                {"cohesive_zone_length_m", crack.zone_length},
-                                                {"elements_in_zone", crack.elements_in_zone},
-                                                {"viscous_time_s", settings.cohesive_viscous_time},
-                                                {"viscosity_Pa_s_per_m", crack.viscosity},
-                                                {"interface_area_m2", crack.interface_area},
-                                                {"warning", crack.warning}}
-                               : nlohmann::json(nullptr);
-  m["samples"] = cp.samples;
-  m["stopped"] = stop.empty() ? nlohmann::json(nullptr) : nlohmann::json(stop);
-  m["resumed_after_sample"] = resumed_from ? nlohmann::json(*resumed_from) : nlohmann::json(nullptr);
-  if (writer) {
-    write_profile_csv(cp.profile, dir / "profile.csv");
-    write_manifest(m, dir / "manifest.json");
-  }
-  reference::wait_for_processes(); // the files are in place when any process returns
-  return cp.profile;
+  m["solver"] = solver;
+  const reference::SolverTimings parts = m_solver->timings(); // rank 0's when distributed
+  m["timings"] = {{"wall_s", wall_seconds},
+                  {"solve_total_s", m_cp.solve_seconds},
+                  {"samples_solved", m_cp.solved},
+                  {"solver_parts_s", {{"assembly", parts.assembly_seconds},
+                                      {"factorization", parts.factorization_seconds},
+                                      {"solve", parts.solve_seconds},
+                                      {"communication", parts.communication_seconds}}}};
+  m["newton_iterations_total"] = m_newton_total;
+  m["energy"] = m_energy.to_json();
+  m["fracture"] = m_crack.active ? nlohmann::json{{"cohesive_law", "bilinear (Camacho-Ortiz effective opening), reference/cohesive/cohesive_law.hpp"},
+                                                  {"cohesive_strength_Pa", m_scene.material.cohesive_strength},
+                                                  {"fracture_toughness_J_per_m2", m_scene.material.fracture_toughness},
+                                                  {"interface_triangles", m_crack.interface_triangles},
+                                                  {"cohesive_zone_length_m", m_crack.zone_length},
+                                                  {"elements_in_zone", m_crack.elements_in_zone},
+                                                  {"viscous_time_s", m_settings.cohesive_viscous_time},
+                                                  {"viscosity_Pa_s_per_m", m_crack.viscosity},
+                                                  {"interface_area_m2", m_crack.interface_area},
+                                                  {"warning", m_crack.warning}}
+                                 : nlohmann::json(nullptr);
+  m["samples"] = m_cp.samples;
+  m["stopped"] = m_stop.empty() ? nlohmann::json(nullptr) : nlohmann::json(m_stop);
+  m["partial"] = !m_stop.empty();
+  m["resumed_after_sample"] = m_resumed_from ? nlohmann::json(*m_resumed_from) : nlohmann::json(nullptr);
+  return m;
+}
+
+} // namespace
+
+ReferenceResult run_reference(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings,
+                              const std::filesystem::path& dir) {
+  return TrajectorySolve(scene, mesh, settings, dir).run();
 }
 
 } // namespace kerf

@@ -19,6 +19,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace kerf {
@@ -48,13 +49,20 @@ struct ReferenceRunSettings {
   /// The requested samples are all solved; the inserted ones join the profile. 0: off.
   double adaptive_force_change = 0.0;
   double adaptive_min_travel = 0.05e-3;
+  /// The load path follows the trajectory (reference/load_path.hpp, trajectory_vertices.hpp):
+  /// besides the requested samples, every vertex of the tools' motion is a load — a sample where
+  /// the motion leaves the straight line in time through its neighbouring vertices by more than
+  /// this distance [m] > 0 (segment ends, dwell start and end, the turns of a recorded hand) — and
+  /// between two loads the tools move along the trajectory. The default, 1 µm, keeps every corner
+  /// of a scripted motion and every turn of a recorded hand larger than a micrometre.
+  double vertex_tolerance = 1e-6;
   /// Viscous regularisation of the cohesive law: relaxation time τ [s] >= 0, η = σ_c τ / δ_f
   /// (add_crack_path); 0 = none. Its dissipation is booked in the manifest's energy.
   double cohesive_viscous_time = 0.0;
   /// The dynamic (inertial) step (reference::SolverSettings::dynamic: Newmark average acceleration,
   /// consistent mass from the scene's density) instead of the quasi-static one; the kinetic energy
   /// joins the manifest's energy. The time step is the spacing of the solved samples (halved by the
-  /// load path's cut-backs). Serial only.
+  /// load path's cut-backs).
   bool dynamic = false;
   /// Dynamic step: the scene's Kelvin–Voigt damping (its materials' `damping` η, the viscous
   /// stress (η/E) ℂ₀ : Ė of reference/material/kelvin_voigt.hpp), its dissipation in the manifest's
@@ -117,13 +125,28 @@ struct ReferenceProblem {
 /// of sample k is t_k / T (T the trajectory duration).
 ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh);
 
+/// What a reference run solved: its profile, and why its load path stopped before the trajectory's
+/// end (empty: it reached the end).
+struct ReferenceResult {
+  ReferenceResult() = default;
+  /// A run that reached the end is its profile (implicit: a study's stand-in reference returns one).
+  ReferenceResult(ForceProfile p, std::string why_stopped = {}) // NOLINT(google-explicit-constructor)
+      : profile(std::move(p)), stopped(std::move(why_stopped)) {}
+  ForceProfile profile;
+  std::string stopped;
+  [[nodiscard]] bool complete() const { return stopped.empty(); }
+};
+
 /// Runs the reference on the scene (see file comment) and returns the profile: one row per tool per
-/// solved sample (t, tool position, force of the body on the tool, mode no-contact when the tool force is
+/// solved sample — the requested samples, every vertex of the motion (ReferenceRunSettings::
+/// vertex_tolerance) and the samples adaptive sampling inserts, each a load of the path — (t, tool position, force of the body on the tool, mode no-contact when the tool force is
 /// zero (tied) / no contact point (penalty) else deformation-1, crack_extent 0, cost_s = solve
 /// seconds). The tool force of a tied tool is the reaction on the tied nodes (a compliant grasp:
 /// the force of the body on its layer, −∫ k (d − u) dA). If the load path
-/// stops (cut-backs exhausted), returns the profile up to the last converged sample and records
-/// the stop message in the manifest. Writes dir/profile.csv, dir/manifest.json, fields and
+/// stops (cut-backs exhausted), returns the profile up to the last converged sample with the stop
+/// message (ReferenceResult::stopped), and the manifest records it (`stopped`, `partial`: true).
+/// The manifest's `solver.load_path` counts the loads (requested, vertices, inserted) and each
+/// sample record says why it is a load (`load`). Writes dir/profile.csv, dir/manifest.json, fields and
 /// checkpoints; prints a progress line per sample on stderr. Throws std::invalid_argument on bad
 /// settings, std::runtime_error on an unreadable or mismatched checkpoint (another scene, degree,
 /// refinement, sample set or process count).
@@ -132,7 +155,7 @@ ReferenceProblem reference_problem(const Scene& scene, const TetMesh& mesh);
 /// alone writes profile.csv, manifest.json, checkpoint.bin and fields.pvd and prints the progress
 /// (with `distribute` false the call is this process's own, and it writes);
 /// distributed fields are fields/step_NNNN.pvtu with one .vtu piece per process.
-ForceProfile run_reference(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings,
-                           const std::filesystem::path& dir);
+ReferenceResult run_reference(const Scene& scene, const TetMesh& mesh, const ReferenceRunSettings& settings,
+                              const std::filesystem::path& dir);
 
 } // namespace kerf

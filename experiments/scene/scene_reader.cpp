@@ -1,14 +1,14 @@
-// Scene files (TOML, toml++) to Scene (scene_reader.hpp). Every key is known, every quantity is
-// converted once, and every error reads "FILE:LINE:COLUMN: KEY: what was expected, got what".
+// Scene files (TOML, toml++) to Scene (scene_reader.hpp), one function per table over the TOML
+// reading layer (toml_reader.hpp): every key is known, every quantity is converted once, and every
+// error reads "FILE:LINE:COLUMN: KEY: expected what, got what". The format: docs/scenes.md.
 
 #include "experiments/scene/scene_reader.hpp"
 
 #include "experiments/scene/quantity.hpp"
-#include "experiments/scene/toml_keys.hpp"
+#include "experiments/scene/toml_reader.hpp"
 
 #include <toml++/toml.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -19,6 +19,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace kerf {
@@ -45,53 +46,7 @@ std::vector<fs::path> geometry_search_path() {
 
 namespace {
 
-/// A table of the scene file with its key path ("tools[1].trajectory") and where it starts.
-struct TableRef {
-  const toml::table& table;
-  std::string path;          ///< "" for the root table
-  toml::source_region where; ///< the table's header (or its parent's, when implicit)
-
-  [[nodiscard]] std::string key(std::string_view k) const {
-    return path.empty() ? std::string(k) : path + "." + std::string(k);
-  }
-  [[nodiscard]] const toml::node* find(std::string_view k) const { return table.get(k); }
-};
-
-std::string type_name(const toml::node& n) {
-  switch (n.type()) {
-  case toml::node_type::table: return "a table";
-  case toml::node_type::array: return "an array";
-  case toml::node_type::string: return "a string";
-  case toml::node_type::integer: return "an integer";
-  case toml::node_type::floating_point: return "a floating-point number";
-  case toml::node_type::boolean: return "a boolean";
-  case toml::node_type::date: return "a date";
-  case toml::node_type::time: return "a time of day";
-  case toml::node_type::date_time: return "a date-time";
-  default: return "nothing";
-  }
-}
-
-/// What was written, for "got ..." in messages.
-std::string found(const toml::node& n) {
-  if (const auto* s = n.as_string()) return "\"" + s->get() + "\"";
-  if (const auto* i = n.as_integer()) return std::to_string(i->get());
-  if (const auto* f = n.as_floating_point()) {
-    std::ostringstream os;
-    os << f->get();
-    return os.str();
-  }
-  if (const auto* b = n.as_boolean()) return b->get() ? "true" : "false";
-  if (const auto* a = n.as_array()) {
-    std::string out = "[";
-    for (std::size_t k = 0; k < a->size(); ++k) {
-      if (k > 0) out += ", ";
-      out += found(*a->get(k));
-    }
-    return out + "]";
-  }
-  return type_name(n);
-}
+using namespace toml_reader;
 
 /// Whether `word` occurs in `text` as a whole identifier.
 bool mentions_identifier(std::string_view text, std::string_view word) {
@@ -112,26 +67,12 @@ constexpr double pi = std::numbers::pi;
 class SceneParser {
 public:
   SceneParser(const fs::path& file, std::vector<fs::path> extra_includes)
-      : m_file(file), m_display(file.string()),
-        m_folder(fs::absolute(file).lexically_normal().parent_path()), m_extra_includes(std::move(extra_includes)) {}
+      : m_file(file), m_source{file.string()}, m_folder(fs::absolute(file).lexically_normal().parent_path()),
+        m_extra_includes(std::move(extra_includes)) {}
 
   Scene read() {
-    std::ifstream in(m_file, std::ios::binary);
-    if (!in) throw SceneError(m_display + ": cannot open the scene file");
-    std::ostringstream text;
-    text << in.rdbuf();
-
-    toml::table root;
-    try {
-      root = toml::parse(text.str(), m_display);
-    } catch (const toml::parse_error& e) {
-      throw SceneError(position(e.source()) + ": TOML syntax: " + std::string(e.description()));
-    }
-
-    toml::source_region top;
-    top.begin = {1, 1};
-    top.end = {1, 1};
-    const TableRef doc{root, "", top};
+    toml::table root = parse_file(m_file, m_source.name + ": cannot open the scene file");
+    const TableRef doc = TableRef::root(m_source, root);
     allow_only(doc, {"scene", "geometry", "material", "layers", "supports", "tools", "models", "include"});
     include_parameter_files(doc, root);
 
@@ -155,7 +96,7 @@ public:
 
 private:
   fs::path m_file;
-  std::string m_display;
+  SourceFile m_source; ///< the file as messages name it
   fs::path m_folder;
   std::vector<fs::path> m_extra_includes; ///< parameter files given by the caller, after the scene's own
   /// The [scene].phenomena entries, for consistency errors at the right place.
@@ -178,156 +119,8 @@ private:
                            std::string_view what) const {
     if (m_geo_text.empty()) return;
     if (m_geo_text.find("\"" + name + "\"") != std::string::npos) return;
-    fail(where(*t.find(key), t), t.key(key),
-         "expected " + std::string(what) + " defined in " + m_geo_name + ", got \"" + name +
+    fail_at(t, key, "expected " + std::string(what) + " defined in " + m_geo_name + ", got \"" + name +
              "\" (no such physical group)");
-  }
-
-  // --- messages -------------------------------------------------------------------------------
-
-  /// "FILE:LINE:COLUMN", FILE the included parameter file when the node came from one.
-  [[nodiscard]] std::string position(const toml::source_region& at) const {
-    const unsigned line = at.begin.line == 0 ? 1u : at.begin.line;
-    const unsigned column = at.begin.column == 0 ? 1u : at.begin.column;
-    const std::string file = at.path && !at.path->empty() ? *at.path : m_display;
-    return file + ":" + std::to_string(line) + ":" + std::to_string(column);
-  }
-
-  [[noreturn]] void fail(const toml::source_region& at, std::string_view key, std::string_view message) const {
-    throw SceneError(position(at) + ": " + std::string(key) + ": " + std::string(message));
-  }
-
-  /// A node's own position, or the enclosing table's when toml++ has none for it.
-  static toml::source_region where(const toml::node& n, const TableRef& parent) {
-    return n.source().begin.line != 0 ? n.source() : parent.where;
-  }
-
-  [[noreturn]] void missing(const TableRef& t, std::string_view key, std::string_view expected) const {
-    fail(t.where, t.key(key), "missing required key (expected " + std::string(expected) + ")");
-  }
-
-  [[noreturn]] void wrong(const toml::node& n, const TableRef& t, const std::string& key,
-                          std::string_view expected) const {
-    fail(where(n, t), key, "expected " + std::string(expected) + ", got " + found(n));
-  }
-
-  // --- tables ---------------------------------------------------------------------------------
-
-  /// Every key of `t` must be one of `allowed`.
-  void allow_only(const TableRef& t, std::initializer_list<std::string_view> allowed,
-                  std::string_view what = "") const {
-    const toml::node* value = nullptr;
-    if (const toml::key* k = first_unknown_key(t.table, allowed, &value)) {
-      const toml::source_region at = k->source().begin.line != 0 ? k->source() : where(*value, t);
-      std::string message = "unknown key";
-      if (!what.empty()) message += std::string(" for ") + std::string(what);
-      fail(at, t.key(k->str()), message + " (expected one of: " + allowed_keys_text(allowed) + ")");
-    }
-  }
-
-  std::optional<TableRef> optional_table(const TableRef& t, std::string_view key) const {
-    const toml::node* n = t.find(key);
-    if (n == nullptr) return std::nullopt;
-    const toml::table* sub = n->as_table();
-    if (sub == nullptr) wrong(*n, t, t.key(key), "a table ([" + t.key(key) + "])");
-    return TableRef{*sub, t.key(key), where(*n, t)};
-  }
-
-  TableRef required_table(const TableRef& t, std::string_view key) const {
-    auto sub = optional_table(t, key);
-    if (!sub) missing(t, key, "a table [" + t.key(key) + "]");
-    return *sub;
-  }
-
-  /// An array of tables ([[key]]), possibly absent (empty result).
-  std::vector<TableRef> table_array(const TableRef& t, std::string_view key) const {
-    std::vector<TableRef> out;
-    const toml::node* n = t.find(key);
-    if (n == nullptr) return out;
-    const toml::array* a = n->as_array();
-    if (a == nullptr) wrong(*n, t, t.key(key), "an array of tables ([[" + t.key(key) + "]])");
-    for (std::size_t k = 0; k < a->size(); ++k) {
-      const toml::node& e = *a->get(k);
-      const std::string path = t.key(key) + "[" + std::to_string(k) + "]";
-      const toml::table* sub = e.as_table();
-      if (sub == nullptr) wrong(e, t, path, "a table ([[" + t.key(key) + "]])");
-      out.push_back(TableRef{*sub, path, where(e, t)});
-    }
-    return out;
-  }
-
-  // --- values ---------------------------------------------------------------------------------
-
-  std::optional<std::string> optional_string(const TableRef& t, std::string_view key) const {
-    const toml::node* n = t.find(key);
-    if (n == nullptr) return std::nullopt;
-    const auto* s = n->as_string();
-    if (s == nullptr) wrong(*n, t, t.key(key), "a string");
-    return s->get();
-  }
-
-  std::string required_string(const TableRef& t, std::string_view key) const {
-    auto s = optional_string(t, key);
-    if (!s) missing(t, key, "a string");
-    if (s->empty()) fail(where(*t.find(key), t), t.key(key), "expected a non-empty string, got \"\"");
-    return *s;
-  }
-
-  /// A quantity node: a string with a unit, or a plain (SI) number.
-  double quantity(const toml::node& n, const TableRef& t, const std::string& key, Dimension d) const {
-    if (const auto* s = n.as_string()) {
-      try {
-        return parse_quantity(s->get(), d);
-      } catch (const QuantityError& e) {
-        fail(where(n, t), key, e.what());
-      }
-    }
-    if (n.is_integer() || n.is_floating_point()) {
-      const double v = *n.value<double>();
-      if (!std::isfinite(v)) fail(where(n, t), key, "expected " + describe(d) + ", got " + found(n) + " (not a finite number)");
-      return v;
-    }
-    wrong(n, t, key, describe(d));
-  }
-
-  std::optional<double> optional_quantity(const TableRef& t, std::string_view key, Dimension d) const {
-    const toml::node* n = t.find(key);
-    if (n == nullptr) return std::nullopt;
-    return quantity(*n, t, t.key(key), d);
-  }
-
-  double required_quantity(const TableRef& t, std::string_view key, Dimension d) const {
-    auto v = optional_quantity(t, key, d);
-    if (!v) missing(t, key, describe(d));
-    return *v;
-  }
-
-  /// Fails at `key` of `t` with "expected <range>, got <written>" unless `ok`.
-  void check(bool ok, const TableRef& t, std::string_view key, std::string_view range) const {
-    if (ok) return;
-    wrong(*t.find(key), t, t.key(key), range);
-  }
-
-  int required_integer(const TableRef& t, std::string_view key) const {
-    const toml::node* n = t.find(key);
-    if (n == nullptr) missing(t, key, "an integer");
-    const auto* i = n->as_integer();
-    if (i == nullptr) wrong(*n, t, t.key(key), "an integer");
-    return static_cast<int>(std::clamp<std::int64_t>(i->get(), -1000000, 1000000));
-  }
-
-  /// A 3-vector: an array of three quantities.
-  Eigen::Vector3d vector3(const TableRef& t, std::string_view key, Dimension d, bool nonzero) const {
-    const toml::node* n = t.find(key);
-    if (n == nullptr) missing(t, key, "an array of three " + describe(d));
-    const toml::array* a = n->as_array();
-    const std::string path = t.key(key);
-    if (a == nullptr || a->size() != 3) wrong(*n, t, path, "an array of three " + describe(d));
-    Eigen::Vector3d v;
-    for (std::size_t k = 0; k < 3; ++k)
-      v[static_cast<Eigen::Index>(k)] = quantity(*a->get(k), t, path + "[" + std::to_string(k) + "]", d);
-    if (nonzero && !(v.norm() > 0.0)) wrong(*n, t, path, "a non-zero vector");
-    return v;
   }
 
   // --- files ----------------------------------------------------------------------------------
@@ -351,7 +144,7 @@ private:
       if (!looked.empty()) looked += ", ";
       looked += c.lexically_normal().string();
     }
-    fail(where(*t.find(key), t), t.key(key), "file \"" + name + "\" not found (looked for: " + looked + ")");
+    fail_at(t, key, "file \"" + name + "\" not found (looked for: " + looked + ")");
   }
 
   // --- included parameter files ---------------------------------------------------------------
@@ -385,26 +178,19 @@ private:
   }
 
   void merge_parameter_file(toml::table& root, const fs::path& file) const {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw SceneError(m_display + ": include: cannot open the parameter file " + file.string());
-    std::ostringstream text;
-    text << in.rdbuf();
-    toml::table included;
-    try {
-      included = toml::parse(text.str(), file.string());
-    } catch (const toml::parse_error& e) {
-      throw SceneError(position(e.source()) + ": TOML syntax: " + std::string(e.description()));
-    }
+    toml::table included =
+        parse_file(file, m_source.name + ": include: cannot open the parameter file " + file.string());
     for (auto&& [key, value] : included) {
       if (key.str() != "models" || !value.is_table())
-        fail(key.source().begin.line != 0 ? key.source() : value.source(), key.str(),
+        fail(m_source, key.source().begin.line != 0 ? key.source() : value.source(), key.str(),
              "a parameter file holds [models.*] tables only (calibrated model parameters; geometry, material, "
              "supports and tools stay in the scene)");
       if (!root.contains("models")) root.insert("models", toml::table{});
       toml::table* models = root["models"].as_table();
       if (models == nullptr) return; // the scene's own "models" is not a table: reported where it is read
       for (auto&& [model, section] : *value.as_table()) {
-        if (!section.is_table()) fail(section.source(), "models." + std::string(model.str()), "expected a table [models." + std::string(model.str()) + "]");
+        const std::string path = "models." + std::string(model.str());
+        if (!section.is_table()) fail(m_source, section.source(), path, "expected a table [" + path + "]");
         if (!models->contains(model.str())) models->insert(model.str(), toml::table{});
         toml::table* into = (*models)[model.str()].as_table();
         if (into == nullptr) continue; // reported where the scene's value is read
@@ -423,16 +209,15 @@ private:
     const toml::node* n = t.find("phenomena");
     const std::string expected = "a non-empty array of phenomena (deformation, cutting, tearing, friction, layers)";
     if (n == nullptr) missing(t, "phenomena", expected);
-    const toml::array* a = n->as_array();
-    if (a == nullptr || a->empty()) wrong(*n, t, t.key("phenomena"), expected);
+    const toml::array& a = non_empty_array(*n, t, t.key("phenomena"), expected);
     m_phenomena_node = n;
-    for (std::size_t k = 0; k < a->size(); ++k) {
-      const toml::node& e = *a->get(k);
-      const std::string path = t.key("phenomena") + "[" + std::to_string(k) + "]";
+    for (std::size_t k = 0; k < a.size(); ++k) {
+      const toml::node& e = *a.get(k);
+      const std::string path = item_key(t.key("phenomena"), k);
       const auto* s = e.as_string();
       const std::optional<Phenomenon> p = s ? phenomenon_from_string(s->get()) : std::nullopt;
       if (!p) wrong(e, t, path, "one of deformation, cutting, tearing, friction, layers");
-      if (scene.phenomena.contains(*p)) fail(where(e, t), path, "\"" + s->get() + "\" is listed twice");
+      if (scene.phenomena.contains(*p)) fail(m_source, where(e, t), path, "\"" + s->get() + "\" is listed twice");
       scene.phenomena.insert(*p);
       m_phenomenon_nodes.push_back({*p, &e, path});
     }
@@ -441,12 +226,40 @@ private:
   SceneGeometry read_geometry(const TableRef& t) {
     allow_only(t, {"geo", "stl", "msh", "stl_scale", "element_size", "element_degree", "parameters"});
     SceneGeometry g;
+    read_geometry_source(t, g);
+    if (t.find("stl_scale") != nullptr) {
+      if (g.kind != SceneGeometry::Kind::stl)
+        fail_at(t, "stl_scale", "only applies to stl geometry");
+      g.stl_scale = required_quantity(t, "stl_scale", Dimension::dimensionless);
+      check(g.stl_scale > 0.0, t, "stl_scale", "a scale > 0");
+    }
+    if (g.kind == SceneGeometry::Kind::msh) {
+      g.element_size = optional_quantity(t, "element_size", Dimension::length).value_or(0.0);
+      if (t.find("element_size") != nullptr) check(g.element_size > 0.0, t, "element_size", "a length > 0");
+    } else {
+      g.element_size = required_quantity(t, "element_size", Dimension::length);
+      check(g.element_size > 0.0, t, "element_size", "a length > 0");
+    }
+    g.nominal_element_size = g.element_size;
+    if (const auto degree = optional_integer_in(t, "element_degree", 1, 2, "1 (linear tetrahedra) or 2 (quadratic)"))
+      g.element_degree = *degree;
+    if (t.find("parameters") != nullptr) {
+      if (g.kind != SceneGeometry::Kind::geo)
+        fail_at(t, "parameters", "only applies to geo geometry");
+      read_geo_parameters(*optional_table(t, "parameters"), g);
+    }
+    return g;
+  }
+
+  /// Exactly one of geo, stl, msh: the geometry's file, found beside the scene or on the geometry
+  /// search path (a .geo file's text kept to check names against).
+  void read_geometry_source(const TableRef& t, SceneGeometry& g) {
     std::string_view source_key;
     for (std::string_view k : {"geo", "stl", "msh"}) {
       if (t.find(k) == nullptr) continue;
       if (!source_key.empty())
-        fail(where(*t.find(k), t), t.key(k),
-             "give exactly one of geo, stl, msh (found " + std::string(source_key) + " and " + std::string(k) + ")");
+        fail_at(t, k,
+                "give exactly one of geo, stl, msh (found " + std::string(source_key) + " and " + std::string(k) + ")");
       source_key = k;
     }
     if (source_key.empty()) missing(t, "geo", "one of geo = \"NAME.geo\", stl = \"NAME.stl\", msh = \"NAME.msh\"");
@@ -465,43 +278,20 @@ private:
       m_geo_text = s.str();
       m_geo_name = g.source.filename().string();
     }
+  }
 
-    if (t.find("stl_scale") != nullptr) {
-      if (g.kind != SceneGeometry::Kind::stl)
-        fail(where(*t.find("stl_scale"), t), t.key("stl_scale"), "only applies to stl geometry");
-      g.stl_scale = required_quantity(t, "stl_scale", Dimension::dimensionless);
-      check(g.stl_scale > 0.0, t, "stl_scale", "a scale > 0");
+  /// [geometry.parameters]: values of the .geo file's parameters, each one the file names.
+  void read_geo_parameters(const TableRef& p, SceneGeometry& g) const {
+    for (auto&& [k, v] : p.table) {
+      const std::string key = p.key(k.str());
+      // Catch misspelt parameters: a .geo parameter is named in its file.
+      if (!mentions_identifier(m_geo_text, k.str()))
+        fail(m_source, k.source().begin.line != 0 ? k.source() : where(v, p), key,
+             "unknown parameter (" + g.source.filename().string() + " does not define \"" + std::string(k.str()) +
+                 "\")");
+      // Strings carry a length unit; plain numbers are SI or unitless (cut_normal).
+      g.parameters[std::string(k.str())] = quantity(v, p, key, Dimension::length);
     }
-
-    if (g.kind == SceneGeometry::Kind::msh) {
-      g.element_size = optional_quantity(t, "element_size", Dimension::length).value_or(0.0);
-      if (t.find("element_size") != nullptr) check(g.element_size > 0.0, t, "element_size", "a length > 0");
-    } else {
-      g.element_size = required_quantity(t, "element_size", Dimension::length);
-      check(g.element_size > 0.0, t, "element_size", "a length > 0");
-    }
-    g.nominal_element_size = g.element_size;
-    if (t.find("element_degree") != nullptr) {
-      g.element_degree = required_integer(t, "element_degree");
-      check(g.element_degree == 1 || g.element_degree == 2, t, "element_degree", "1 (linear tetrahedra) or 2 (quadratic)");
-    }
-
-    if (const toml::node* n = t.find("parameters")) {
-      if (g.kind != SceneGeometry::Kind::geo)
-        fail(where(*n, t), t.key("parameters"), "only applies to geo geometry");
-      const auto p = optional_table(t, "parameters");
-      for (auto&& [k, v] : p->table) {
-        const std::string key = p->key(k.str());
-        // Catch misspelt parameters: a .geo parameter is named in its file.
-        if (!mentions_identifier(m_geo_text, k.str()))
-          fail(k.source().begin.line != 0 ? k.source() : where(v, *p), key,
-               "unknown parameter (" + g.source.filename().string() + " does not define \"" +
-                   std::string(k.str()) + "\")");
-        // Strings carry a length unit; plain numbers are SI or unitless (cut_normal).
-        g.parameters[std::string(k.str())] = quantity(v, *p, key, Dimension::length);
-      }
-    }
-    return g;
   }
 
   /// The base material (`base == nullptr`, region "body") or a layer: a copy of `base` with the
@@ -517,16 +307,12 @@ private:
     Material m = layer ? *base : Material{};
     m.region = layer ? required_string(t, "region") : "body";
 
-    if (const auto law = layer ? optional_string(t, "law") : std::optional(required_string(t, "law"))) {
-      if (*law == "neo-hookean")
-        m.law = MaterialLaw::neo_hookean;
-      else if (*law == "decoupled-neo-hookean")
-        m.law = MaterialLaw::decoupled_neo_hookean;
-      else if (*law == "st-venant-kirchhoff")
-        m.law = MaterialLaw::st_venant_kirchhoff;
-      else
-        wrong(*t.find("law"), t, t.key("law"), "\"neo-hookean\", \"decoupled-neo-hookean\" or \"st-venant-kirchhoff\"");
-    }
+    const std::initializer_list<std::pair<std::string_view, MaterialLaw>> laws{
+        {"neo-hookean", MaterialLaw::neo_hookean},
+        {"decoupled-neo-hookean", MaterialLaw::decoupled_neo_hookean},
+        {"st-venant-kirchhoff", MaterialLaw::st_venant_kirchhoff}};
+    if (const auto law = layer ? optional_choice(t, "law", laws) : std::optional(required_choice(t, "law", laws)))
+      m.law = *law;
 
     // Required in the base material; cutting/tearing need J_c and σ_c, friction needs μ.
     const bool fracture = phenomena.contains(Phenomenon::cutting) || phenomena.contains(Phenomenon::tearing);
@@ -559,8 +345,7 @@ private:
       Material m = read_material(t, &scene.material, scene.phenomena);
       check_physical_name(t, "region", m.region, "a physical volume");
       if (!regions.insert(m.region).second || m.region == "body")
-        fail(where(*t.find("region"), t), t.key("region"),
-             "region \"" + m.region + "\" is already used (each layer needs its own physical volume)");
+        fail_at(t, "region", "region \"" + m.region + "\" is already used (each layer needs its own physical volume)");
       scene.layers.push_back(std::move(m));
       m_layer_where.push_back(t.where);
     }
@@ -574,13 +359,8 @@ private:
       Support s;
       s.surface = required_string(t, "surface");
       check_physical_name(t, "surface", s.surface, "a physical surface");
-      const std::string kind = required_string(t, "kind");
-      if (kind == "bonded")
-        s.kind = Support::Kind::bonded;
-      else if (kind == "sliding")
-        s.kind = Support::Kind::sliding;
-      else
-        wrong(*t.find("kind"), t, t.key("kind"), "\"bonded\" or \"sliding\"");
+      s.kind = required_choice<Support::Kind>(t, "kind", {{"bonded", Support::Kind::bonded},
+                                                         {"sliding", Support::Kind::sliding}});
       scene.supports.push_back(std::move(s));
     }
   }
@@ -589,54 +369,59 @@ private:
     const auto tables = table_array(doc, "tools");
     if (tables.empty()) missing(doc, "tools", "one or two [[tools]] tables");
     if (tables.size() > 2)
-      fail(tables[2].where, tables[2].path,
+      fail(m_source, tables[2].where, tables[2].path,
            "a scene has one or two tools (found " + std::to_string(tables.size()) + ")");
     for (const TableRef& t : tables) {
       Tool tool;
       tool.name = required_string(t, "name");
       for (const Tool& other : scene.tools)
         if (other.name == tool.name)
-          fail(where(*t.find("name"), t), t.key("name"), "tool name \"" + tool.name + "\" is used twice");
-      const std::string kind = required_string(t, "kind");
-      if (kind == "blade") {
-        tool.kind = Tool::Kind::blade;
-        allow_only(t, {"name", "kind", "edge_direction", "cutting_direction", "edge_length", "wedge_angle",
-                       "thickness", "trajectory"},
-                   "a blade tool");
-        BladeShape& b = tool.blade;
-        b.edge_direction = vector3(t, "edge_direction", Dimension::dimensionless, true).normalized();
-        b.cutting_direction = vector3(t, "cutting_direction", Dimension::dimensionless, true).normalized();
-        if (!(std::abs(b.edge_direction.dot(b.cutting_direction)) < 1e-6)) {
-          std::ostringstream cosine;
-          cosine << b.edge_direction.dot(b.cutting_direction);
-          fail(where(*t.find("cutting_direction"), t), t.key("cutting_direction"),
-               "expected a direction orthogonal to edge_direction, got " + found(*t.find("cutting_direction")) +
-                   " (cosine " + cosine.str() + " with edge_direction " + found(*t.find("edge_direction")) + ")");
-        }
-        b.edge_length = required_quantity(t, "edge_length", Dimension::length);
-        check(b.edge_length > 0.0, t, "edge_length", "a length > 0");
-        b.wedge_angle = required_quantity(t, "wedge_angle", Dimension::angle);
-        check(b.wedge_angle > 0.0 && b.wedge_angle < pi, t, "wedge_angle", "an angle in (0, 180 deg)");
-        b.thickness = required_quantity(t, "thickness", Dimension::length);
-        check(b.thickness > 0.0, t, "thickness", "a length > 0");
-      } else if (kind == "sphere") {
-        tool.kind = Tool::Kind::sphere;
-        allow_only(t, {"name", "kind", "radius", "grasp_radius", "grasp_stiffness", "trajectory"}, "a sphere tool");
-        tool.radius = required_quantity(t, "radius", Dimension::length);
-        check(tool.radius > 0.0, t, "radius", "a length > 0");
-        if ((tool.grasp_radius = optional_quantity(t, "grasp_radius", Dimension::length)))
-          check(*tool.grasp_radius > 0.0, t, "grasp_radius", "a length > 0");
-        if ((tool.grasp_stiffness = optional_quantity(t, "grasp_stiffness", Dimension::stiffness_per_area))) {
-          check(*tool.grasp_stiffness > 0.0, t, "grasp_stiffness", "a stiffness per area > 0");
-          check(tool.grasp_radius.has_value(), t, "grasp_stiffness",
-                "a grasp_radius beside it (the stiffness is the grasped disc's)");
-        }
-      } else {
-        wrong(*t.find("kind"), t, t.key("kind"), "\"blade\" or \"sphere\"");
-      }
+          fail_at(t, "name", "tool name \"" + tool.name + "\" is used twice");
+      tool.kind =
+          required_choice<Tool::Kind>(t, "kind", {{"blade", Tool::Kind::blade}, {"sphere", Tool::Kind::sphere}});
+      if (tool.kind == Tool::Kind::blade)
+        tool.blade = read_blade(t);
+      else
+        read_sphere(t, tool);
       tool.trajectory = read_trajectory(required_table(t, "trajectory"));
       scene.tools.push_back(std::move(tool));
       m_tool_where.push_back(t.where);
+    }
+  }
+
+  BladeShape read_blade(const TableRef& t) const {
+    allow_only(t, {"name", "kind", "edge_direction", "cutting_direction", "edge_length", "wedge_angle",
+                   "thickness", "trajectory"},
+               "a blade tool");
+    BladeShape b;
+    b.edge_direction = vector3(t, "edge_direction", Dimension::dimensionless, true).normalized();
+    b.cutting_direction = vector3(t, "cutting_direction", Dimension::dimensionless, true).normalized();
+    if (!(std::abs(b.edge_direction.dot(b.cutting_direction)) < 1e-6)) {
+      std::ostringstream cosine;
+      cosine << b.edge_direction.dot(b.cutting_direction);
+      fail_at(t, "cutting_direction",
+              "expected a direction orthogonal to edge_direction, got " + found(*t.find("cutting_direction")) +
+                  " (cosine " + cosine.str() + " with edge_direction " + found(*t.find("edge_direction")) + ")");
+    }
+    b.edge_length = required_quantity(t, "edge_length", Dimension::length);
+    check(b.edge_length > 0.0, t, "edge_length", "a length > 0");
+    b.wedge_angle = required_quantity(t, "wedge_angle", Dimension::angle);
+    check(b.wedge_angle > 0.0 && b.wedge_angle < pi, t, "wedge_angle", "an angle in (0, 180 deg)");
+    b.thickness = required_quantity(t, "thickness", Dimension::length);
+    check(b.thickness > 0.0, t, "thickness", "a length > 0");
+    return b;
+  }
+
+  void read_sphere(const TableRef& t, Tool& tool) const {
+    allow_only(t, {"name", "kind", "radius", "grasp_radius", "grasp_stiffness", "trajectory"}, "a sphere tool");
+    tool.radius = required_quantity(t, "radius", Dimension::length);
+    check(tool.radius > 0.0, t, "radius", "a length > 0");
+    if ((tool.grasp_radius = optional_quantity(t, "grasp_radius", Dimension::length)))
+      check(*tool.grasp_radius > 0.0, t, "grasp_radius", "a length > 0");
+    if ((tool.grasp_stiffness = optional_quantity(t, "grasp_stiffness", Dimension::stiffness_per_area))) {
+      check(*tool.grasp_stiffness > 0.0, t, "grasp_stiffness", "a stiffness per area > 0");
+      check(tool.grasp_radius.has_value(), t, "grasp_stiffness",
+            "a grasp_radius beside it (the stiffness is the grasped disc's)");
     }
   }
 
@@ -648,7 +433,7 @@ private:
     if (t.find("file") != nullptr) {
       for (std::string_view k : {"start", "segments"})
         if (t.find(k) != nullptr)
-          fail(where(*t.find(k), t), t.key(k), "a recorded trajectory (file) takes no start or segments");
+          fail_at(t, k, "a recorded trajectory (file) takes no start or segments");
       spec.recorded_file = resolve_file(t, "file", required_string(t, "file"), {});
       return spec;
     }
@@ -657,20 +442,17 @@ private:
     if (segments.empty()) missing(t, "segments", "at least one [[" + t.key("segments") + "]] (or file = \"NAME.csv\")");
     for (const TableRef& s : segments) {
       TrajectorySegment seg;
-      const std::string kind = required_string(s, "kind");
-      if (kind == "move") {
+      seg.kind = required_choice<TrajectorySegment::Kind>(
+          s, "kind", {{"move", TrajectorySegment::Kind::move}, {"dwell", TrajectorySegment::Kind::dwell}});
+      if (seg.kind == TrajectorySegment::Kind::move) {
         allow_only(s, {"kind", "label", "to", "speed"}, "a move segment");
-        seg.kind = TrajectorySegment::Kind::move;
         seg.target = vector3(s, "to", Dimension::length, false);
         seg.speed = required_quantity(s, "speed", Dimension::velocity);
         check(seg.speed > 0.0, s, "speed", "a speed > 0");
-      } else if (kind == "dwell") {
+      } else {
         allow_only(s, {"kind", "label", "duration"}, "a dwell segment");
-        seg.kind = TrajectorySegment::Kind::dwell;
         seg.duration = required_quantity(s, "duration", Dimension::time);
         check(seg.duration > 0.0, s, "duration", "a duration > 0");
-      } else {
-        wrong(*s.find("kind"), s, s.key("kind"), "\"move\" or \"dwell\"");
       }
       seg.label = optional_string(s, "label").value_or("");
       spec.segments.push_back(std::move(seg));
@@ -686,14 +468,11 @@ private:
     check(f.rupture_force_per_length > 0.0, t, "rupture_force_per_length", "a force per length > 0");
     f.rupture_deflection = required_quantity(t, "rupture_deflection", Dimension::length);
     check(f.rupture_deflection > 0.0, t, "rupture_deflection", "a length > 0");
-    f.deformation_1_exponent = required_integer(t, "deformation_1_exponent");
-    check(f.deformation_1_exponent >= 1 && f.deformation_1_exponent <= 3, t, "deformation_1_exponent",
-          "an exponent 1, 2 or 3 (paper 001 §6)");
+    const std::string_view exponent = "an exponent 1, 2 or 3 (paper 001 §6)";
+    f.deformation_1_exponent = required_integer_in(t, "deformation_1_exponent", 1, 3, exponent);
     f.crack_deflection = required_quantity(t, "crack_deflection", Dimension::length);
     check(f.crack_deflection > 0.0, t, "crack_deflection", "a length > 0");
-    f.deformation_2_exponent = required_integer(t, "deformation_2_exponent");
-    check(f.deformation_2_exponent >= 1 && f.deformation_2_exponent <= 3, t, "deformation_2_exponent",
-          "an exponent 1, 2 or 3 (paper 001 §6)");
+    f.deformation_2_exponent = required_integer_in(t, "deformation_2_exponent", 1, 3, exponent);
     f.lateral_stiffness = required_quantity(t, "lateral_stiffness", Dimension::force_per_length);
     check(f.lateral_stiffness >= 0.0, t, "lateral_stiffness", "a stiffness >= 0");
     f.presliding_stiffness = required_quantity(t, "presliding_stiffness", Dimension::force_per_length);
@@ -731,14 +510,8 @@ private:
         v.grid[k] = static_cast<int>(i->get());
       }
     }
-    for (const auto& [key, flag] : {std::pair{"depth_cutting_stiffness", &v.depth_cutting_stiffness},
-                                    std::pair{"clip_friction", &v.clip_friction}}) {
-      if (const toml::node* n = t.find(key)) {
-        const auto* b = n->as_boolean();
-        if (b == nullptr) wrong(*n, t, t.key(key), "true or false");
-        *flag = b->get();
-      }
-    }
+    v.depth_cutting_stiffness = optional_boolean(t, "depth_cutting_stiffness").value_or(v.depth_cutting_stiffness);
+    v.clip_friction = optional_boolean(t, "clip_friction").value_or(v.clip_friction);
     return v;
   }
 
@@ -750,10 +523,7 @@ private:
       s.stiffness_scale = *v;
       check(*v > 0.0, t, "stiffness_scale", "a factor > 0");
     }
-    if (t.find("cells") != nullptr) {
-      s.cells = required_integer(t, "cells");
-      check(*s.cells >= 1 && *s.cells <= 64, t, "cells", "a cell count per side in 1 .. 64");
-    }
+    s.cells = optional_integer_in(t, "cells", 1, 64, "a cell count per side in 1 .. 64");
     if (const toml::node* n = t.find("cell_size")) {
       const auto* text = n->as_string();
       if (text == nullptr || text->get() != "auto") {
@@ -761,18 +531,9 @@ private:
         check(*s.cell_size > 0.0, t, "cell_size", "a length > 0 or \"auto\"");
       }
     }
-    if (const auto integrator = optional_string(t, "integrator")) {
-      if (*integrator != "explicit" && *integrator != "explicit-double" && *integrator != "implicit" &&
-          *integrator != "linear-implicit" && *integrator != "static")
-        wrong(*t.find("integrator"), t, t.key("integrator"),
-              "\"explicit\", \"explicit-double\", \"implicit\", \"linear-implicit\" or \"static\"");
-      s.integrator = *integrator;
-    }
-    if (const toml::node* n = t.find("volume_term")) {
-      const auto* b = n->as_boolean();
-      if (b == nullptr) wrong(*n, t, t.key("volume_term"), "true or false");
-      s.volume_term = b->get();
-    }
+    s.integrator =
+        optional_one_of(t, "integrator", {"explicit", "explicit-double", "implicit", "linear-implicit", "static"});
+    s.volume_term = optional_boolean(t, "volume_term");
     if ((s.tensile_limit = optional_quantity(t, "tensile_limit", Dimension::pressure)))
       check(*s.tensile_limit > 0.0, t, "tensile_limit", "a stress > 0");
     if ((s.damping = optional_quantity(t, "damping", Dimension::viscosity)))
@@ -787,14 +548,14 @@ private:
   /// Fails at the entry of scene.phenomena that declares `p`.
   [[noreturn]] void fail_at_phenomenon(Phenomenon p, std::string_view message) const {
     for (const PhenomenonEntry& e : m_phenomenon_nodes)
-      if (e.phenomenon == p) fail(e.node->source(), e.key, message);
-    fail(m_phenomena_node->source(), "scene.phenomena", message);
+      if (e.phenomenon == p) fail(m_source, e.node->source(), e.key, message);
+    fail(m_source, m_phenomena_node->source(), "scene.phenomena", message);
   }
 
   void check_consistency(const Scene& scene) const {
     const bool has_layers = scene.phenomena.contains(Phenomenon::layers);
     if (!scene.layers.empty() && !has_layers)
-      fail(m_layer_where.front(), "layers[0]",
+      fail(m_source, m_layer_where.front(), "layers[0]",
            "the scene has [[layers]] but scene.phenomena does not declare \"layers\"");
     if (has_layers && scene.layers.empty())
       fail_at_phenomenon(Phenomenon::layers, "\"layers\" is declared but the scene has no [[layers]] table");
@@ -822,7 +583,11 @@ const char* material_law_name(MaterialLaw law) {
 }
 
 Scene read_scene(const fs::path& file, const std::vector<fs::path>& parameter_files) {
-  return SceneParser(file, parameter_files).read();
+  try {
+    return SceneParser(file, parameter_files).read();
+  } catch (const TomlError& e) {
+    throw SceneError(e.what());
+  }
 }
 
 } // namespace kerf

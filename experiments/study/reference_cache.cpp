@@ -16,7 +16,7 @@
 namespace kerf {
 
 ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, const Scene& scene, int level,
-                                              const std::vector<std::size_t>& sample_indices) {
+                                              const std::vector<std::size_t>& sample_indices, LoadIncrement increment) {
   ReferenceRunSettings settings;
   settings.degree = spec.degree_of(scene.file.stem().string(), scene.geometry.element_degree);
   // Every level of a scene with a geometry is meshed anew (study_reference_scene); a ready .msh
@@ -27,6 +27,13 @@ ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, co
   settings.linear_solver = spec.linear_solver;
   settings.fracture = spec.fracture;
   settings.distribute = false; // one process per solve: the study spreads whole solves over its ranks
+  // Adaptive sampling down to a travel tied to the scene's own element size h0 (the level's h
+  // times 2^level for a scene meshed anew, a .msh scene's own), so every level of a scene has
+  // the same least travel; half the increment halves it.
+  const double h0 = scene.geometry.kind == SceneGeometry::Kind::msh ? scene.geometry.element_size
+                                                                   : std::ldexp(scene.geometry.element_size, level);
+  settings.adaptive_force_change = spec.adaptive;
+  settings.adaptive_min_travel = study_min_travel_per_element * h0 * (increment == LoadIncrement::half ? 0.5 : 1.0);
   return settings;
 }
 
@@ -130,6 +137,8 @@ ReferenceCacheKey reference_cache_key(const Scene& scene, const ReferenceRunSett
   text += "solver_version = " + std::to_string(solver_version) + "\n";
   text += "degree = " + std::to_string(settings.degree) + "\n";
   text += "adaptive_sampling = " + exact(settings.adaptive_force_change) + " " + exact(settings.adaptive_min_travel) + "\n";
+  // The load path: the trajectory, through every vertex of the motion (reference_run.hpp).
+  text += "load_path = trajectory vertices, tolerance " + exact(settings.vertex_tolerance) + "\n";
   text += "refinements = " + std::to_string(settings.refinements) + "\n";
   text += "linear_solver = " + std::string(solver_name(settings.linear_solver)) + "\n";
   text += "direct_dof_limit = " + std::to_string(defaults.direct_dof_limit) + "\n";

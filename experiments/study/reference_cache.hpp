@@ -22,14 +22,24 @@
 
 namespace kerf {
 
+/// The load increment of a study's reference solve: the study's own, or half of it (the second
+/// solve of the finest level that verifies the reference in time, StudyReferenceSpec::time_verification).
+enum class LoadIncrement { whole, half };
+
 /// The settings a study's reference solve of `scene` at mesh level `level` runs with: `spec`'s
 /// degree for the scene (StudyReferenceSpec::degree_of its file's stem and its element_degree),
-/// linear solver and fracture mode, the solved `sample_indices`, no field files, no refinement (the
-/// level is the scene meshed anew: study_reference_scene; a .msh scene refined `level` times), and the
-/// mesh not distributed (each solve is one process's run, whatever the study's MPI ranks:
-/// study_runner.hpp).
+/// linear solver and fracture mode, the solved `sample_indices`, adaptive sampling with `spec`'s
+/// force change and a least travel of 1/40 of the scene's own element size (1/80 at half the
+/// increment), no field files, no refinement (the level is the scene meshed anew:
+/// study_reference_scene; a .msh scene refined `level` times), and the mesh not distributed (each
+/// solve is one process's run, whatever the study's MPI ranks: study_runner.hpp).
 ReferenceRunSettings study_reference_settings(const StudyReferenceSpec& spec, const Scene& scene, int level,
-                                              const std::vector<std::size_t>& sample_indices);
+                                              const std::vector<std::size_t>& sample_indices,
+                                              LoadIncrement increment = LoadIncrement::whole);
+
+/// The least tool travel between two samples that a study's adaptive sampling inserts, per unit
+/// of the scene's own element size (at the whole increment).
+inline constexpr double study_min_travel_per_element = 1.0 / 40.0;
 
 /// The scene a study's reference solves at mesh level `level`: `scene` itself for a level >= 0
 /// (its mesh refined `level` times: element size h/2^level), and for a level k < 0 the scene meshed

@@ -1,5 +1,6 @@
 #include "experiments/study/reference_verification.hpp"
 
+#include "experiments/study/profile_metrics.hpp"
 #include "experiments/study/study_runner.hpp"
 
 #include <algorithm>
@@ -93,13 +94,21 @@ std::optional<ReferenceVerification> verify_reference(const std::vector<Referenc
                                   std::to_string(rows.size()) + " sample(s) of tool " + tool + ", fewer than 2");
     v.samples = rows.size();
     rows_at[k] = rows;
+  }
+  // Time weights of the common samples (profile_metrics.hpp): the same times at every level.
+  std::vector<double> times;
+  for (const ProfileRow* r : rows_at[0]) times.push_back(r->t);
+  const std::vector<double> w = sample_time_weights(times);
+  double total = 0.0;
+  for (double x : w) total += x;
+  for (int k = 0; k < 3; ++k) {
     double sum = 0.0;
     peak[k] = 0.0;
-    for (const ProfileRow* r : rows) {
-      sum += r->force.squaredNorm();
-      peak[k] = std::max(peak[k], r->force.norm());
+    for (std::size_t i = 0; i < rows_at[k].size(); ++i) {
+      sum += w[i] * rows_at[k][i]->force.squaredNorm();
+      peak[k] = std::max(peak[k], rows_at[k][i]->force.norm());
     }
-    rms[k] = std::sqrt(sum / static_cast<double>(rows.size()));
+    rms[k] = std::sqrt(sum / total);
   }
   v.rms_force = rms[0];
   v.peak_force = peak[0];
@@ -108,12 +117,83 @@ std::optional<ReferenceVerification> verify_reference(const std::vector<Referenc
   // The RMS over the common samples of the force differences between successive levels.
   const auto rms_difference = [&](int a, int b) {
     double sum = 0.0;
-    for (std::size_t i = 0; i < rows_at[a].size(); ++i) sum += (rows_at[a][i]->force - rows_at[b][i]->force).squaredNorm();
-    return std::sqrt(sum / static_cast<double>(rows_at[a].size()));
+    for (std::size_t i = 0; i < rows_at[a].size(); ++i) sum += w[i] * (rows_at[a][i]->force - rows_at[b][i]->force).squaredNorm();
+    return std::sqrt(sum / total);
   };
   v.profile = difference_convergence(v.element_sizes[0], v.element_sizes[1], v.element_sizes[2], rms_difference(0, 1),
                                      rms_difference(1, 2), formal_order);
   return v;
+}
+
+std::string SamplingVerification::summary() const {
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "sampling uncertainty %.2g %% of the peak (the run at the study's load increment, %zu samples, against half of "
+                "it, %zu samples: %.3g N RMS at %zu common times, RMS |F| moves %.3g N, peak |F| %.3g N; largest at t = %.4g s, %s: "
+                "%.3g N against %.3g N)",
+                peak_force > 0.0 ? 100.0 * uncertainty() / peak_force : 0.0, loads_whole, loads_half, rms_difference, samples, rms_shift,
+                peak_difference, largest_difference_time, std::string(to_string(largest_difference_mode)).c_str(), largest_difference_force,
+                largest_difference_force_half);
+  return text;
+}
+
+SamplingVerification verify_sampling(const ForceProfile& whole, const ForceProfile& half, const std::string& tool) {
+  const auto all_whole = rows_of_tool(whole, tool), all_half = rows_of_tool(half, tool);
+  // rows_of_tool points into its profile: the common profiles are kept while their rows are read.
+  const ForceProfile common_whole = at_common_times(whole, half), common_half = at_common_times(half, whole);
+  const auto a = rows_of_tool(common_whole, tool);
+  const auto b = rows_of_tool(common_half, tool);
+  if (a.size() < 2 || a.size() != b.size())
+    throw std::invalid_argument("sampling verification: the runs at the study's load increment and at half of it share " +
+                                std::to_string(std::min(a.size(), b.size())) + " output time(s) of tool " + tool + ", fewer than 2");
+  SamplingVerification v;
+  v.samples = a.size();
+  v.loads_whole = all_whole.size();
+  v.loads_half = all_half.size();
+  std::vector<double> times;
+  for (const ProfileRow* r : a) times.push_back(r->t);
+  const std::vector<double> w = sample_time_weights(times);
+  double sum = 0.0, total = 0.0, largest = -1.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double d = (a[i]->force - b[i]->force).norm();
+    sum += w[i] * d * d;
+    total += w[i];
+    if (d > largest) {
+      largest = d;
+      v.largest_difference_time = a[i]->t;
+      v.largest_difference_mode = a[i]->mode;
+      v.largest_difference_force = a[i]->force.norm();
+      v.largest_difference_force_half = b[i]->force.norm();
+    }
+  }
+  v.rms_difference = std::sqrt(sum / total);
+  // The time-weighted RMS |F| of each run over its own samples.
+  const auto rms_over_own_samples = [](const std::vector<const ProfileRow*>& rows) {
+    std::vector<double> t;
+    for (const ProfileRow* r : rows) t.push_back(r->t);
+    const std::vector<double> weights = sample_time_weights(t);
+    double s = 0.0, total_weight = 0.0;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      s += weights[i] * rows[i]->force.squaredNorm();
+      total_weight += weights[i];
+    }
+    return total_weight > 0.0 ? std::sqrt(s / total_weight) : 0.0;
+  };
+  v.rms_shift = std::abs(rms_over_own_samples(all_half) - rms_over_own_samples(all_whole));
+  double peak_half = 0.0;
+  for (const ProfileRow* r : all_whole) v.peak_force = std::max(v.peak_force, r->force.norm());
+  for (const ProfileRow* r : all_half) peak_half = std::max(peak_half, r->force.norm());
+  v.peak_difference = std::abs(peak_half - v.peak_force);
+  return v;
+}
+
+std::optional<double> combined_uncertainty(const std::optional<ReferenceVerification>& space,
+                                           const std::optional<SamplingVerification>& time) {
+  const std::optional<double> u_space = space ? space->profile_uncertainty() : std::nullopt;
+  if (!time) return u_space;
+  const double u_time = time->uncertainty();
+  if (!u_space) return u_time;
+  return std::sqrt(*u_space * *u_space + u_time * u_time);
 }
 
 ReferenceBand reference_band(const std::vector<ReferenceLevel>& levels, const std::optional<ReferenceVerification>& verification,

@@ -3,10 +3,11 @@
 // samples all three solved, give the observed order, the Richardson-extrapolated value and the GCI
 // (solution_verification.hpp) of two trajectory-wide quantities of the tool's force F:
 //
-//   RMS |F| = sqrt(mean_k |F_k|^2) over the common samples,   peak |F| = max_k |F_k|,
+//   RMS |F| = sqrt(Σ_k w_k |F_k|^2 / Σ_k w_k) over the common samples,   peak |F| = max_k |F_k|,
 //
-// and of the force profile itself, from the RMS of the differences between levels
-// (difference_convergence): e21 = sqrt(mean_k |F2_k − F1_k|^2), e32 likewise. The profile's
+// (w_k the time a sample stands for, profile_metrics.hpp) and of the force profile itself, from
+// the RMS of the differences between levels (difference_convergence): e21 = sqrt(Σ_k w_k |F2_k −
+// F1_k|^2 / Σ_k w_k), e32 likewise. The same profile is verified in time (SamplingVerification). The profile's
 // uncertainty U (in newtons, the scale of a model's RMS force error) is what the study table sets
 // beside the models' RMS force errors, and the band a profile plot draws around the reference is
 // the same estimate sample by sample (gci_band_half_width with the order used), or, where it is not
@@ -18,6 +19,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <string>
@@ -54,6 +56,50 @@ struct ReferenceVerification {
   /// GCI 2 % on peak |F| = …; L-1, L0, L1 (h = 4, 2, 1 mm), 12 common samples", or why no GCI.
   [[nodiscard]] std::string summary() const;
 };
+
+/// The verification of a scene's reference in time (the load increment is a discretisation too: a
+/// cut's crack front advances element by element between loads): its finest level solved with the
+/// study's load increment (N requested samples) and again with half of it (2N − 1 requested, the N
+/// among them, adaptive sampling's least travel halved). Two differences measure it: the two
+/// profiles' difference at the output times both solved, in the time-weighted RMS norm of the
+/// study's force error (profile_metrics.hpp) — the load path's effect on the solution — and the
+/// shift of the time-weighted RMS |F| of each run over its own samples — the sampling's effect on
+/// a time average (a crack front's element-by-element saw-tooth sampled at other phases). The
+/// larger of the two is the sampling uncertainty of the finest profile.
+struct SamplingVerification {
+  std::size_t samples = 0;       ///< output times both runs solved (of the scored tool)
+  std::size_t loads_whole = 0;   ///< samples the run at the study's increment solved
+  std::size_t loads_half = 0;    ///< samples the run at half the increment solved
+  double peak_force = 0.0;       ///< peak |F| of the run at the study's increment [N]
+  /// sqrt(Σ_k w_k |F_k − F½_k|² / Σ_k w_k) over the common times [N].
+  double rms_difference = 0.0;
+  /// |RMS |F½| − RMS |F||, each the time-weighted RMS over its run's own samples [N].
+  double rms_shift = 0.0;
+  /// |max |F½| − max |F||, each peak over all the samples its run solved [N]: the peak a denser
+  /// load path finds between the coarser one's samples.
+  double peak_difference = 0.0;
+  /// Where the two runs differ most: the common output time [s], the finest run's mode there, and
+  /// |F| of either run [N] (a crack front that advanced by another step, a release).
+  double largest_difference_time = 0.0;
+  InteractionMode largest_difference_mode = InteractionMode::no_contact;
+  double largest_difference_force = 0.0, largest_difference_force_half = 0.0;
+  /// The sampling uncertainty [N]: max(rms_difference, rms_shift).
+  [[nodiscard]] double uncertainty() const { return std::max(rms_difference, rms_shift); }
+  /// "sampling uncertainty 0.8 % of the peak (…: 0.04 N RMS at 57 common times, RMS |F| moves
+  /// 0.01 N, peak |F| 0.02 N; largest at t = 0.699 s, cutting: 0.141 N against 0.253 N)".
+  [[nodiscard]] std::string summary() const;
+};
+
+/// The verification in time from the finest level's two runs (see SamplingVerification). Throws
+/// std::invalid_argument when they share fewer than two output times of `tool`.
+SamplingVerification verify_sampling(const ForceProfile& whole, const ForceProfile& half, const std::string& tool);
+
+/// The uncertainty of the finest force profile in the study's RMS norm [N], the discretisations in
+/// space and in time together: the root sum square of the two (ASME V&V 20-2009, §2-4: the
+/// numerical uncertainty of independent sources combined as a root sum square), or the one that
+/// is available; empty when neither is.
+std::optional<double> combined_uncertainty(const std::optional<ReferenceVerification>& space,
+                                           const std::optional<SamplingVerification>& time);
 
 /// The verification from `levels` (any order; the three with the smallest element sizes are used)
 /// for the rows of `tool`; `formal_order` caps the profile's observed order (the finite elements'

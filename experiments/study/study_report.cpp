@@ -5,16 +5,20 @@
 
 #include "meshes/atomic_file.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 
 namespace kerf {
 
 std::optional<double> rms_error_floor(const SceneReference& reference) {
-  if (!reference.verification) return std::nullopt;
-  const auto u = reference.verification->profile_uncertainty();
-  if (!u || !(reference.verification->peak_force > 0.0)) return std::nullopt;
-  return *u / reference.verification->peak_force;
+  const auto u = reference.uncertainty();
+  double peak = 0.0;
+  if (!reference.level_profiles.empty())
+    for (const ProfileRow& r : reference.level_profiles.back().rows)
+      if (r.tool == reference.tool) peak = std::max(peak, r.force.norm());
+  if (!u || !(peak > 0.0)) return std::nullopt;
+  return *u / peak;
 }
 
 StudyTable verification_table(const StudyResult& result) {
@@ -25,10 +29,22 @@ StudyTable verification_table(const StudyResult& result) {
                 {"convergence", "", 3, 1.0},      {"extrapolated", "N", 5, 1.0},   {"e_a", "%", 3, 100.0},
                 {"e_ext", "%", 3, 100.0},         {"GCI_fine", "%", 3, 100.0},     {"note", "", 3, 1.0}});
   using O = std::optional<double>;
+  // The verification in time: the RMS difference of the finest level at the study's load
+  // increment and at half of it (φ1), its share of the peak in the GCI column.
+  const auto add_sampling_row = [&](const SceneReference& r) {
+    if (!r.sampling) return;
+    const SamplingVerification& v = *r.sampling;
+    char runs[96];
+    std::snprintf(runs, sizeof runs, "L%d: %zu and %zu samples", r.levels.back(), v.loads_whole, v.loads_half);
+    t.add_row({r.scene, std::string("force profile in time (half the load increment)"), std::string(runs),
+               O(r.element_sizes.back()), O(), O(), O(v.rms_difference), O(), O(), O(2.0), O(), O(), std::string(), O(), O(), O(),
+               v.peak_force > 0.0 ? O(v.uncertainty() / v.peak_force) : O(), v.summary()});
+  };
   for (const SceneReference& r : result.references) {
     if (!r.verification) {
       t.add_row({r.scene, std::string("RMS |F|, peak |F|"), std::string(), O(), O(), O(), O(), O(), O(), O(), O(), O(), std::string(), O(),
                  O(), O(), O(), r.note});
+      add_sampling_row(r);
       continue;
     }
     const ReferenceVerification& v = *r.verification;
@@ -48,6 +64,7 @@ StudyTable verification_table(const StudyResult& result) {
                O(v.element_sizes[2]), O(v.rms_force), O(d.e21), O(d.e32), O(d.r21), O(d.r32), d.observed_order,
                std::string(d.usable() ? "monotonic" : "none"), O(), O(), O(),
                d.usable() && v.peak_force > 0.0 ? O(*d.uncertainty / v.peak_force) : O(), order_note});
+    add_sampling_row(r);
   }
   return t;
 }
@@ -59,7 +76,7 @@ namespace {
 ProfilePlotReference write_reference_series(const SceneReference& reference, const Eigen::Vector3d& direction, const std::filesystem::path& csv) {
   std::vector<ReferenceLevel> levels;
   for (std::size_t k = 0; k < reference.levels.size(); ++k)
-    levels.push_back({reference.levels[k], reference.element_sizes[k], read_profile_csv(reference.profiles[k])});
+    levels.push_back({reference.levels[k], reference.element_sizes[k], reference.level_profiles[k]});
   std::size_t finest = 0;
   for (std::size_t k = 1; k < levels.size(); ++k)
     if (levels[k].element_size < levels[finest].element_size) finest = k;
@@ -98,6 +115,7 @@ ProfilePlotReference write_reference_series(const SceneReference& reference, con
 void write_study_report(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out) {
   namespace fs = std::filesystem;
   result.table().write(out, "study");
+  result.phase_table().write(out, "study_phases");
   if (!result.references.empty()) verification_table(result).write(out, "verification");
   for (const fs::path& scene_file : spec.scenes) {
     const Scene scene = read_scene(scene_file);

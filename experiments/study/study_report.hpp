@@ -1,6 +1,7 @@
 #pragma once
 // What a study writes once its runs are done (tables and plots an author can submit):
-// the table (study.md/.tex/.csv), the reference's solution verification (verification.md/.csv),
+// the table (study.md/.tex/.csv), the errors per phase (study_phases.md/.tex/.csv), the
+// reference's solution verification (verification.md/.csv),
 // and per scene the profile plot with the reference and its band (SCENE_profiles.png/.pdf/.csv)
 // and the speed/accuracy chart (SCENE_pareto.png/.pdf/.csv). Every figure has its data beside it.
 
@@ -19,7 +20,8 @@ namespace kerf {
 StudyTable verification_table(const StudyResult& result);
 
 /// The reference uncertainty of a scene on the study table's RMS force error scale [–]: the
-/// uncertainty of RMS |F| [N] over the finest level's peak |F| [N]; empty without a usable GCI.
+/// uncertainty of the finest force profile [N] (space and time, SceneReference::uncertainty) over
+/// the finest level's peak |F| [N]; empty without either verification.
 std::optional<double> rms_error_floor(const SceneReference& reference);
 
 /// Writes the tables and the plots of `result` into `out` (study.*, verification.*, and per scene of

@@ -1,15 +1,19 @@
+// Study files (TOML) to StudySpec (study_spec.hpp): one function per table over the TOML reading
+// layer the scene reader uses (experiments/scene/toml_reader.hpp), so every error reads
+// "FILE:LINE:COLUMN: KEY: expected what, got what". The format: docs/studies.md, "Study file".
+
 #include "experiments/study/study_spec.hpp"
 
 #include "experiments/calibration/free_parameters.hpp"
 #include "experiments/models/model_description.hpp"
+#include "experiments/scene/toml_reader.hpp"
 #include "experiments/study/model_resolution.hpp"
-#include "experiments/scene/toml_keys.hpp"
 
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <limits>
-#include <map>
 #include <string_view>
 #include <system_error>
 
@@ -17,265 +21,298 @@ namespace kerf {
 
 namespace {
 
-[[noreturn]] void fail(const std::filesystem::path& file, const toml::source_region& where, const std::string& key,
-                       const std::string& what) {
-  throw StudyError(file.string() + ":" + std::to_string(where.begin.line) + ":" + std::to_string(where.begin.column) +
-                   ": " + key + ": " + what);
-}
+using namespace toml_reader;
+namespace fs = std::filesystem;
 
-void allow_only(const std::filesystem::path& file, const toml::table& t, const std::string& prefix,
-                std::initializer_list<std::string_view> keys) {
-  const toml::node* value = nullptr;
-  if (const toml::key* k = first_unknown_key(t, keys, &value))
-    fail(file, value->source(), prefix + std::string(k->str()), "unknown key (expected one of: " + allowed_keys_text(keys) + ")");
-}
+/// A count of samples is an int: its bound is the type's, not a smaller policy.
+constexpr std::int64_t int_max = std::numeric_limits<int>::max();
+const std::string samples_range = "an integer in 2.." + std::to_string(int_max);
 
-std::vector<std::string> strings(const std::filesystem::path& file, const toml::table& t, const std::string& key,
-                                 const std::string& prefix) {
-  const toml::array* a = t[key].as_array();
-  if (!a) fail(file, t.source(), prefix + key, "expected an array of strings");
-  std::vector<std::string> out;
-  for (const toml::node& n : *a) {
-    const auto s = n.value<std::string>();
-    if (!s || s->empty()) fail(file, n.source(), prefix + key, "expected a non-empty string");
-    out.push_back(*s);
-  }
-  if (out.empty()) fail(file, a->source(), prefix + key, "expected at least one entry");
+std::string joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const std::string& n : names) out += (out.empty() ? "" : ", ") + n;
   return out;
+}
+
+/// The study's scenes by name (their files' stems), as other tables name them.
+std::vector<std::string> scene_names(const StudySpec& spec) {
+  std::vector<std::string> out;
+  for (const fs::path& p : spec.scenes) out.push_back(p.stem().string());
+  return out;
+}
+
+bool contains(const std::vector<std::string>& names, std::string_view name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+/// The position of key `k` of table `t` (whose value is `v`), or of its value when toml++ has none
+/// for the key.
+toml::source_region key_position(const toml::key& k, const toml::node& v, const TableRef& t) {
+  return k.source().begin.line != 0 ? k.source() : where(v, t);
+}
+
+/// The string at `k` of `t`: one of `names` (the study's scenes or models), described as `what`.
+std::string one_of_study(const TableRef& t, std::string_view k, const std::vector<std::string>& names,
+                         std::string_view what) {
+  const std::string expected = std::string(what) + " (" + joined(names) + ")";
+  const toml::node* n = t.find(k);
+  if (n == nullptr) missing(t, k, expected);
+  const auto* s = n->as_string();
+  if (s == nullptr || !contains(names, s->get())) wrong(*n, t, t.key(k), expected);
+  return s->get();
+}
+
+// --- [study] ---------------------------------------------------------------------------------------
+
+/// The scene file a study names `name`: NAME beside the study file (a .toml file), else
+/// experiments/scenes/NAME.toml.
+std::optional<fs::path> find_scene(const fs::path& study_file, const std::string& name) {
+  const fs::path beside = study_file.parent_path() / name;
+  const fs::path named = fs::path(KERF_SCENES_DIR) / (name + ".toml");
+  std::error_code ec; // a name the file system cannot look up (too long) is no scene, not an exception
+  if (fs::exists(beside, ec) && beside.extension() == ".toml") return beside;
+  if (fs::exists(named, ec)) return named;
+  return std::nullopt;
+}
+
+void read_header(const TableRef& t, StudySpec& spec) {
+  allow_only(t, {"name", "description", "scenes", "models"});
+  spec.name = required_string(t, "name");
+  spec.description = optional_string(t, "description").value_or("");
+  const auto scenes = required_strings(t, "scenes");
+  for (std::size_t i = 0; i < scenes.size(); ++i) {
+    const auto file = find_scene(spec.file, scenes[i].first);
+    if (!file)
+      fail(t.file, where(*scenes[i].second, t), t.key("scenes"),
+           "no scene \"" + scenes[i].first + "\" beside the study or in " + KERF_SCENES_DIR);
+    spec.scenes.push_back(*file);
+  }
+  const auto models = required_strings(t, "models");
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    if (find_model(models[i].first) == nullptr) {
+      std::vector<std::string> catalogue;
+      for (const ModelDescription& m : model_catalogue()) catalogue.emplace_back(m.name);
+      wrong(*models[i].second, t, item_key(t.key("models"), i), "a model of the catalogue (" + joined(catalogue) + ")");
+    }
+    spec.models.push_back(models[i].first);
+  }
+}
+
+// --- [reference] -----------------------------------------------------------------------------------
+
+/// Mesh levels: ascending, the last the finest.
+std::vector<int> mesh_levels(const toml::node& n, const TableRef& t, const std::string& key) {
+  return ascending_integers(n, t, key, minimum_study_mesh_level, 4,
+                            "ascending mesh levels in " + std::to_string(minimum_study_mesh_level) +
+                                "..4 (level k: the scene's element size times 2^-k; the last is the finest)");
+}
+
+/// An element degree: 1 or 2.
+int element_degree(const toml::node& n, const TableRef& t, const std::string& key) {
+  return integer_in(n, t, key, 1, 2, "1 or 2");
+}
+
+/// A number of reference samples: 2 or more.
+int sample_count(const toml::node& n, const TableRef& t, const std::string& key) {
+  return integer_in(n, t, key, 2, int_max, samples_range);
+}
+
+/// `KEY = { SCENE = VALUE, ... }` of [reference]: a scene of the study's own value, each read by
+/// `read(node, table, key)`.
+template <typename Value, typename Read>
+std::map<std::string, Value> per_scene(const TableRef& t, std::string_view k, const StudySpec& spec,
+                                       std::string_view value, Read read) {
+  std::map<std::string, Value> out;
+  const auto table = optional_table(t, k, "a table { SCENE = " + std::string(value) + " }");
+  if (!table) return out;
+  const std::vector<std::string> scenes = scene_names(spec);
+  for (auto&& [name, node] : table->table) {
+    const std::string scene(name.str());
+    if (!contains(scenes, scene))
+      fail(t.file, where(node, *table), table->key(scene), "expected a scene of study.scenes (" + joined(scenes) + ")");
+    out[scene] = read(node, *table, table->key(scene));
+  }
+  return out;
+}
+
+/// [reference] library: a folder, relative to the study file (it need not exist yet).
+fs::path library_folder(const TableRef& t, const fs::path& study_file) {
+  const std::string name = *optional_string(t, "library");
+  check(!name.empty(), t, "library", "a folder, relative to the study file");
+  const fs::path folder = (study_file.parent_path() / name).lexically_normal();
+  std::error_code ec;
+  if (fs::exists(folder, ec) && !fs::is_directory(folder, ec))
+    fail_at(t, "library", "expected a folder, not the file " + folder.string());
+  return folder;
+}
+
+void read_reference(const TableRef& t, StudySpec& spec) {
+  allow_only(t, {"degree", "scene_degree", "refinements", "scene_refinements", "samples", "scene_samples",
+                 "adaptive", "time_verification", "linear_solver", "fracture", "library"});
+  spec.has_reference = true;
+  StudyReferenceSpec& r = spec.reference;
+  // Unset: each scene's own degree ([geometry] element_degree).
+  if (const toml::node* n = t.find("degree")) r.degree = element_degree(*n, t, t.key("degree"));
+  r.scene_degree = per_scene<int>(t, "scene_degree", spec, "1 or 2", element_degree);
+  if (const toml::node* n = t.find("refinements")) r.refinements = mesh_levels(*n, t, t.key("refinements"));
+  r.scene_refinements = per_scene<std::vector<int>>(t, "scene_refinements", spec, "[levels]", mesh_levels);
+  if (const toml::node* n = t.find("samples")) r.samples = sample_count(*n, t, t.key("samples"));
+  r.scene_samples = per_scene<int>(t, "scene_samples", spec, samples_range, sample_count);
+  if (const auto adaptive = optional_number(t, "adaptive")) {
+    r.adaptive = *adaptive;
+    check(*adaptive >= 0.0 && *adaptive < 1.0, t, "adaptive", "a fraction of the peak force in [0, 1) (0: off)");
+  }
+  r.time_verification = optional_boolean(t, "time_verification").value_or(r.time_verification);
+  if (t.find("library") != nullptr) r.library = library_folder(t, spec.file);
+  using reference::LinearSolverChoice;
+  r.linear_solver = optional_choice<LinearSolverChoice>(t, "linear_solver",
+                                                        {{"auto", LinearSolverChoice::automatic},
+                                                         {"direct", LinearSolverChoice::direct},
+                                                         {"iterative", LinearSolverChoice::iterative}})
+                        .value_or(r.linear_solver);
+  r.fracture = optional_choice<ReferenceFracture>(t, "fracture",
+                                                  {{"off", ReferenceFracture::off},
+                                                   {"auto", ReferenceFracture::automatic},
+                                                   {"on", ReferenceFracture::on}})
+                   .value_or(r.fracture);
+}
+
+// --- [models.NAME] ---------------------------------------------------------------------------------
+
+/// [models.NAME] resolutions: ascending values of the model's knob (model_resolution.hpp).
+std::vector<int> model_resolutions(const toml::node& n, const TableRef& t, const std::string& model) {
+  std::pair<int, int> range;
+  try {
+    range = resolution_range(model);
+  } catch (const std::invalid_argument& e) {
+    fail(t.file, where(n, t), t.key("resolutions"), e.what());
+  }
+  const std::string expected =
+      "ascending integers in " + std::to_string(range.first) + ".." + std::to_string(range.second);
+  return ascending_integers(n, t, t.key("resolutions"), range.first, range.second, expected);
+}
+
+void read_model_tables(const TableRef& doc, StudySpec& spec) {
+  const auto models = optional_table(doc, "models", "tables [models.NAME]");
+  if (!models) return;
+  for (auto&& [name, section] : models->table) {
+    const std::string model(name.str());
+    if (!contains(spec.models, model))
+      fail(doc.file, key_position(name, section, *models), models->key(model),
+           "expected a model of study.models (" + joined(spec.models) + ")");
+    const TableRef t = *optional_table(*models, model, "a table [" + models->key(model) + "]");
+    allow_only(t, {"resolutions"});
+    if (const toml::node* r = t.find("resolutions")) spec.resolutions[model] = model_resolutions(*r, t, model);
+  }
+}
+
+// --- [calibration] ---------------------------------------------------------------------------------
+
+/// A parameter file of [calibration]: beside the study, with a [models.*] table.
+fs::path parameter_file(const toml::node& n, const TableRef& t, const std::string& key, const fs::path& study_file) {
+  const std::string name = string_item(n, t, key, "a parameter file, relative to the study file");
+  const fs::path file = study_file.parent_path() / name;
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec))
+    fail(t.file, where(n, t), key, "no parameter file \"" + name + "\" beside the study");
+  if (calibrated_models(file).empty()) fail(t.file, where(n, t), key, file.string() + " has no [models.*] table");
+  return file;
+}
+
+void read_calibrations(const TableRef& doc, StudySpec& spec) {
+  const auto calibration = optional_table(doc, "calibration", "a table [calibration] of SCENE = [parameter files]");
+  if (!calibration) return;
+  const std::vector<std::string> scenes = scene_names(spec);
+  for (auto&& [name, files] : calibration->table) {
+    const std::string scene(name.str());
+    const std::string key = calibration->key(scene);
+    if (!contains(scenes, scene))
+      fail(doc.file, key_position(name, files, *calibration), key,
+           "expected a scene of study.scenes (" + joined(scenes) + ")");
+    const toml::array& a = non_empty_array(files, *calibration, key, "an array of parameter files");
+    for (std::size_t i = 0; i < a.size(); ++i)
+      spec.calibrations[scene].push_back(parameter_file(*a.get(i), *calibration, item_key(key, i), spec.file));
+  }
+}
+
+// --- [[calibrate]] ---------------------------------------------------------------------------------
+
+StudyCalibrationFit read_fit(const TableRef& t, const StudySpec& spec) {
+  allow_only(t, {"scene", "model", "speed", "max_evaluations", "samples"});
+  StudyCalibrationFit fit;
+  fit.scene = one_of_study(t, "scene", scene_names(spec), "a scene of study.scenes");
+  fit.model = one_of_study(t, "model", spec.models, "a model of study.models");
+  if (free_parameters(fit.model).empty())
+    fail_at(t, "model", "model \"" + fit.model + "\" has no free parameters to calibrate");
+  if (const auto speed = optional_number(t, "speed")) {
+    fit.speed = *speed;
+    check(*speed > 0.0 && *speed != 1.0, t, "speed",
+          "a speed factor > 0 other than 1 (the scene's own trajectory is held out)");
+  }
+  fit.max_evaluations =
+      optional_integer_in(t, "max_evaluations", 1, 100000, "an integer in 1..100000").value_or(fit.max_evaluations);
+  fit.samples = optional_integer_in(t, "samples", 2, 100000, "an integer in 2..100000").value_or(fit.samples);
+  return fit;
+}
+
+/// One calibrated row per model and scene: a fit that no parameter file of [calibration] and no
+/// other fit already gives.
+void check_fit_is_new(const TableRef& t, const StudySpec& spec, const StudyCalibrationFit& fit) {
+  const std::string what = "model " + fit.model + " on " + fit.scene;
+  const auto files = spec.calibrations.find(fit.scene);
+  if (files != spec.calibrations.end())
+    for (const fs::path& f : files->second) {
+      const auto models = calibrated_models(f);
+      if (contains(models, fit.model))
+        fail(t.file, t.where, t.path, what + " is already calibrated by " + f.string() +
+                                          " ([calibration]): one calibrated row per model and scene");
+    }
+  for (const StudyCalibrationFit& other : spec.fits)
+    if (other.scene == fit.scene && other.model == fit.model) fail(t.file, t.where, t.path, what + " is fitted twice");
+}
+
+void read_fits(const TableRef& doc, StudySpec& spec) {
+  const toml::node* n = doc.find("calibrate");
+  if (n == nullptr) return;
+  const std::vector<TableRef> fits = table_array(doc, "calibrate", ElementPaths::array_name);
+  if (fits.empty()) wrong(*n, doc, "calibrate", "tables [[calibrate]]");
+  if (!spec.has_reference)
+    fail(doc.file, where(*n, doc), "calibrate", "a fitted calibration needs the study's [reference] to fit to");
+  for (const TableRef& t : fits) {
+    const StudyCalibrationFit fit = read_fit(t, spec);
+    check_fit_is_new(t, spec, fit);
+    spec.fits.push_back(fit);
+  }
 }
 
 } // namespace
 
 StudySpec read_study(const std::filesystem::path& file) {
-  toml::table doc;
   try {
-    doc = toml::parse_file(file.string());
-  } catch (const toml::parse_error& e) {
-    throw StudyError(file.string() + ":" + std::to_string(e.source().begin.line) + ":" +
-                     std::to_string(e.source().begin.column) + ": TOML syntax: " + std::string(e.description()));
+    // Study files report an unknown key at its value (StudySpec.ErrorsNameFileLineColumnAndKey).
+    const SourceFile source{file.string(), UnknownKeyAt::value};
+    const toml::table root = parse_file(file, source.name + ": cannot open the study file");
+    const TableRef doc = TableRef::root(source, root);
+    allow_only(doc, {"study", "reference", "calibration", "calibrate", "models"});
+    StudySpec spec;
+    spec.file = file;
+    read_header(required_table(doc, "study"), spec);
+    if (const auto reference = optional_table(doc, "reference")) read_reference(*reference, spec);
+    read_model_tables(doc, spec);
+    read_calibrations(doc, spec);
+    read_fits(doc, spec);
+    return spec;
+  } catch (const TomlError& e) {
+    throw StudyError(e.what());
   }
-  StudySpec spec;
-  spec.file = file;
-  allow_only(file, doc, "", {"study", "reference", "calibration", "calibrate", "models"});
-  const toml::table* study = doc["study"].as_table();
-  if (!study) throw StudyError(file.string() + ": missing table [study]");
-  allow_only(file, *study, "study.", {"name", "description", "scenes", "models"});
-  const auto name = (*study)["name"].value<std::string>();
-  if (!name || name->empty()) fail(file, study->source(), "study.name", "expected a non-empty string");
-  spec.name = *name;
-  spec.description = (*study)["description"].value_or(std::string{});
-  for (const std::string& s : strings(file, *study, "scenes", "study.")) {
-    const std::filesystem::path beside = file.parent_path() / s;
-    const std::filesystem::path named = std::filesystem::path(KERF_SCENES_DIR) / (s + ".toml");
-    std::error_code ec; // a name the file system cannot look up (too long) is no scene, not an exception
-    if (std::filesystem::exists(beside, ec) && beside.extension() == ".toml") spec.scenes.push_back(beside);
-    else if (std::filesystem::exists(named, ec)) spec.scenes.push_back(named);
-    else fail(file, (*study)["scenes"].node()->source(), "study.scenes", "no scene \"" + s + "\" beside the study or in " + KERF_SCENES_DIR);
-  }
-  for (const std::string& m : strings(file, *study, "models", "study.")) {
-    if (!find_model(m)) fail(file, (*study)["models"].node()->source(), "study.models", "unknown model \"" + m + "\"");
-    spec.models.push_back(m);
-  }
-  if (const toml::table* ref = doc["reference"].as_table()) {
-    spec.has_reference = true;
-    allow_only(file, *ref, "reference.", {"degree", "scene_degree", "refinements", "scene_refinements", "samples", "scene_samples", "linear_solver",
-                                           "fracture", "library"});
-    if (auto d = (*ref)["degree"]) {
-      // Integers are TOML integers, as in scene files: value_exact, never toml++'s value<int64_t>(),
-      // which casts a float (6.7e87, say) to int64_t unchecked (undefined behaviour; found by
-      // fuzz_study, fuzz/regressions/study/).
-      const auto v = d.value_exact<int64_t>();
-      if (!v || (*v != 1 && *v != 2)) fail(file, d.node()->source(), "reference.degree", "expected 1 or 2");
-      spec.reference.degree = static_cast<int>(*v); // else each scene's own
-    }
-    // An array of ascending mesh levels, the last the finest.
-    auto read_levels = [&](const toml::node_view<const toml::node>& r, const std::string& key) {
-      const toml::array* a = r.as_array();
-      const std::string range = std::to_string(minimum_study_mesh_level) + "..4";
-      if (!a || a->empty()) fail(file, r.node()->source(), key, "expected an array of levels in " + range);
-      std::vector<int> levels;
-      for (const toml::node& n : *a) {
-        const auto v = n.value_exact<int64_t>();
-        if (!v || *v < minimum_study_mesh_level || *v > 4)
-          fail(file, n.source(), key, "expected a level in " + range + " (k < 0: the scene's element size times 2^-k)");
-        if (!levels.empty() && *v <= levels.back()) fail(file, n.source(), key, "expected ascending levels (the last is the finest)");
-        levels.push_back(static_cast<int>(*v));
-      }
-      return levels;
-    };
-    if (auto r = (*ref)["refinements"]) spec.reference.refinements = read_levels(r, "reference.refinements");
-    if (auto r = (*ref)["scene_refinements"]) {
-      const toml::table* t = r.as_table();
-      if (!t) fail(file, r.node()->source(), "reference.scene_refinements", "expected a table { SCENE = [levels] }");
-      for (const auto& [name, levels] : *t) {
-        const std::string scene(name.str());
-        const bool known = std::any_of(spec.scenes.begin(), spec.scenes.end(),
-                                       [&](const std::filesystem::path& p) { return p.stem().string() == scene; });
-        if (!known) fail(file, levels.source(), "reference.scene_refinements." + scene, "expected a scene of study.scenes");
-        spec.reference.scene_refinements[scene] =
-            read_levels(toml::node_view<const toml::node>(&levels), "reference.scene_refinements." + scene);
-      }
-    }
-    // A table { SCENE = integer } of the study's scenes, each value in [lo, hi].
-    auto read_scene_integers = [&](std::string_view table_key, std::int64_t lo, std::int64_t hi, const std::string& expected) {
-      std::map<std::string, int> values;
-      const std::string path = "reference." + std::string(table_key);
-      const auto r = (*ref)[table_key];
-      const toml::table* t = r.as_table();
-      if (!t) fail(file, r.node()->source(), path, "expected a table { SCENE = " + expected + " }");
-      for (const auto& [name, value] : *t) {
-        const std::string scene(name.str());
-        const std::string key = path + "." + scene;
-        const bool known = std::any_of(spec.scenes.begin(), spec.scenes.end(),
-                                       [&](const std::filesystem::path& p) { return p.stem().string() == scene; });
-        if (!known) fail(file, value.source(), key, "expected a scene of study.scenes");
-        const auto v = value.value_exact<int64_t>();
-        if (!v || *v < lo || *v > hi) fail(file, value.source(), key, "expected " + expected);
-        values[scene] = static_cast<int>(*v);
-      }
-      return values;
-    };
-    if ((*ref)["scene_degree"]) spec.reference.scene_degree = read_scene_integers("scene_degree", 1, 2, "1 or 2");
-    if (auto l = (*ref)["library"]) {
-      const auto v = l.value<std::string>();
-      if (!v || v->empty()) fail(file, l.node()->source(), "reference.library", "expected a folder, relative to the study file");
-      spec.reference.library = (file.parent_path() / *v).lexically_normal();
-      if (std::filesystem::exists(spec.reference.library) && !std::filesystem::is_directory(spec.reference.library))
-        fail(file, l.node()->source(), "reference.library", "expected a folder, not the file " + spec.reference.library.string());
-    }
-    if (auto s = (*ref)["samples"]) {
-      const auto v = s.value_exact<int64_t>();
-      if (!v || *v < 2 || *v > std::numeric_limits<int>::max())
-        fail(file, s.node()->source(), "reference.samples", "expected an integer in 2..2147483647");
-      spec.reference.samples = static_cast<int>(*v);
-    }
-    if ((*ref)["scene_samples"])
-      spec.reference.scene_samples =
-          read_scene_integers("scene_samples", 2, std::numeric_limits<int>::max(), "an integer in 2..2147483647");
-    if (auto s = (*ref)["linear_solver"]) {
-      const auto v = s.value<std::string>();
-      if (v == "auto") spec.reference.linear_solver = reference::LinearSolverChoice::automatic;
-      else if (v == "direct") spec.reference.linear_solver = reference::LinearSolverChoice::direct;
-      else if (v == "iterative") spec.reference.linear_solver = reference::LinearSolverChoice::iterative;
-      else fail(file, s.node()->source(), "reference.linear_solver", "expected \"auto\", \"direct\" or \"iterative\"");
-    }
-    if (auto s = (*ref)["fracture"]) {
-      const auto v = s.value<std::string>();
-      if (v == "off") spec.reference.fracture = ReferenceFracture::off;
-      else if (v == "auto") spec.reference.fracture = ReferenceFracture::automatic;
-      else if (v == "on") spec.reference.fracture = ReferenceFracture::on;
-      else fail(file, s.node()->source(), "reference.fracture", "expected \"off\", \"auto\" or \"on\"");
-    }
-  }
-  if (const toml::node* m = doc.get("models")) {
-    const toml::table* models = m->as_table();
-    if (!models) fail(file, m->source(), "models", "expected tables [models.NAME]");
-    for (const auto& [name, section] : *models) {
-      const std::string key = "models." + std::string(name.str());
-      if (std::find(spec.models.begin(), spec.models.end(), name.str()) == spec.models.end())
-        fail(file, name.source(), key, "expected a model of study.models");
-      const toml::table* t = section.as_table();
-      if (!t) fail(file, section.source(), key, "expected a table");
-      allow_only(file, *t, key + ".", {"resolutions"});
-      const toml::node* r = t->get("resolutions");
-      if (!r) continue;
-      std::pair<int, int> range;
-      try {
-        range = resolution_range(std::string(name.str()));
-      } catch (const std::invalid_argument& e) {
-        fail(file, r->source(), key + ".resolutions", e.what());
-      }
-      const std::string expected = "expected ascending integers in " + std::to_string(range.first) + ".." + std::to_string(range.second);
-      const toml::array* a = r->as_array();
-      if (!a || a->empty()) fail(file, r->source(), key + ".resolutions", expected);
-      std::vector<int>& values = spec.resolutions[std::string(name.str())];
-      for (const toml::node& n : *a) {
-        const auto v = n.value_exact<int64_t>();
-        if (!v || *v < range.first || *v > range.second || (!values.empty() && *v <= values.back()))
-          fail(file, n.source(), key + ".resolutions", expected);
-        values.push_back(static_cast<int>(*v));
-      }
-    }
-  }
-  if (const toml::node* c = doc.get("calibration")) {
-    const toml::table* cal = c->as_table();
-    if (!cal) fail(file, c->source(), "calibration", "expected a table [calibration] of scene = [parameter files]");
-    for (const auto& [scene, files] : *cal) {
-      const std::string key = "calibration." + std::string(scene.str());
-      bool known = false;
-      for (const std::filesystem::path& f : spec.scenes) known = known || f.stem() == scene.str();
-      if (!known) fail(file, scene.source(), key, "no scene of that name in study.scenes");
-      const toml::array* a = files.as_array();
-      if (!a || a->empty()) fail(file, files.source(), key, "expected an array of parameter files");
-      for (const toml::node& n : *a) {
-        const auto name = n.value<std::string>();
-        const std::filesystem::path p = file.parent_path() / name.value_or("");
-        std::error_code ec;
-        if (!name || !std::filesystem::is_regular_file(p, ec)) fail(file, n.source(), key, "no parameter file \"" + name.value_or("") + "\" beside the study");
-        if (calibrated_models(p).empty()) fail(file, n.source(), key, p.string() + " has no [models.*] table");
-        spec.calibrations[std::string(scene.str())].push_back(p);
-      }
-    }
-  }
-  if (const toml::node* c = doc.get("calibrate")) {
-    const toml::array* fits = c->as_array();
-    if (!fits || !fits->is_array_of_tables()) fail(file, c->source(), "calibrate", "expected tables [[calibrate]]");
-    if (!spec.has_reference) fail(file, c->source(), "calibrate", "a fitted calibration needs the study's [reference] to fit to");
-    for (const toml::node& n : *fits) {
-      const toml::table& t = *n.as_table();
-      allow_only(file, t, "calibrate.", {"scene", "model", "speed", "max_evaluations", "samples"});
-      StudyCalibrationFit fit;
-      const auto scene = t["scene"].value<std::string>();
-      bool known = false;
-      for (const std::filesystem::path& f : spec.scenes) known = known || (scene && f.stem() == *scene);
-      if (!known) fail(file, t["scene"].node() ? t["scene"].node()->source() : t.source(), "calibrate.scene", "expected a scene of study.scenes");
-      fit.scene = *scene;
-      const auto model = t["model"].value<std::string>();
-      if (!model || std::find(spec.models.begin(), spec.models.end(), *model) == spec.models.end())
-        fail(file, t["model"].node() ? t["model"].node()->source() : t.source(), "calibrate.model", "expected a model of study.models");
-      if (free_parameters(*model).empty())
-        fail(file, t["model"].node()->source(), "calibrate.model", "model \"" + *model + "\" has no free parameters to calibrate");
-      fit.model = *model;
-      if (auto v = t["speed"]) {
-        const auto f = v.value<double>();
-        if (!f || !(*f > 0.0) || *f == 1.0)
-          fail(file, v.node()->source(), "calibrate.speed", "expected a speed factor > 0 other than 1 (the scene's own trajectory is held out)");
-        fit.speed = *f;
-      }
-      if (auto v = t["max_evaluations"]) {
-        const auto e = v.value_exact<int64_t>();
-        if (!e || *e < 1 || *e > 100000) fail(file, v.node()->source(), "calibrate.max_evaluations", "expected an integer in 1..100000");
-        fit.max_evaluations = static_cast<int>(*e);
-      }
-      if (auto v = t["samples"]) {
-        const auto n = v.value_exact<int64_t>();
-        if (!n || *n < 2 || *n > 100000) fail(file, v.node()->source(), "calibrate.samples", "expected an integer in 2..100000");
-        fit.samples = static_cast<int>(*n);
-      }
-      const auto files = spec.calibrations.find(fit.scene);
-      if (files != spec.calibrations.end())
-        for (const std::filesystem::path& f : files->second) {
-          const auto models = calibrated_models(f);
-          if (std::find(models.begin(), models.end(), fit.model) != models.end())
-            fail(file, t.source(), "calibrate", "model " + fit.model + " on " + fit.scene + " is already calibrated by " + f.string() +
-                                                    " ([calibration]): one calibrated row per model and scene");
-        }
-      for (const StudyCalibrationFit& other : spec.fits)
-        if (other.scene == fit.scene && other.model == fit.model)
-          fail(file, t.source(), "calibrate", "model " + fit.model + " on " + fit.scene + " is fitted twice");
-      spec.fits.push_back(fit);
-    }
-  }
-  return spec;
 }
 
 std::vector<std::string> calibrated_models(const std::filesystem::path& parameter_file) {
   toml::table doc;
   try {
-    doc = toml::parse_file(parameter_file.string());
-  } catch (const toml::parse_error& e) {
-    throw StudyError(parameter_file.string() + ":" + std::to_string(e.source().begin.line) + ":" +
-                     std::to_string(e.source().begin.column) + ": TOML syntax: " + std::string(e.description()));
+    doc = parse_file(parameter_file, parameter_file.string() + ": cannot open the parameter file");
+  } catch (const TomlError& e) {
+    throw StudyError(e.what());
   }
   std::vector<std::string> out;
   if (const toml::table* models = doc["models"].as_table())

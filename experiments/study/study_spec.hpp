@@ -1,48 +1,7 @@
 #pragma once
-// A study file (experiments/studies/NAME.toml): scenes x models x resolutions (docs/studies.md).
-//
-//   [study]
-//   name = "default"
-//   description = "…"
-//   scenes = ["potato_rect_cut", "clay_pull"]      # names in experiments/scenes, or paths
-//   models = ["fracture", "springs", "edge", "voxel"]   # each runs on the scenes it can represent
-//
-//   [reference]                                    # optional: the finite-element ground truth
-//   degree = 1                                     # every scene's element degree (default: each
-//                                                  # scene's own, [geometry] element_degree)
-//   refinements = [0, 1]                           # mesh levels, ascending; the last is the finest;
-//                                                  # level k: the scene meshed anew at 2^-k times
-//                                                  # its element size (a .msh scene: refined k times)
-//   samples = 40                                   # trajectory samples the reference solves
-//   linear_solver = "auto"                         # "auto", "direct" or "iterative"
-//   fracture = "off"                               # cohesive fracture: "off", "auto" or "on"
-//   scene_refinements = { potato_rect_cut = [-3, -2, -1] }   # a scene's own levels (optional)
-//   scene_degree = { clay_pull = 2 }               # a scene's own element degree (optional)
-//   scene_samples = { potato_rect_cut = 48 }       # a scene's own sample count (optional)
-//
-//   [models.springs]                               # optional: a model at several resolutions,
-//   resolutions = [4, 8, 12]                       # one row "springs [N = 4]" … each (instead of the
-//                                                  # plain row): the points of its speed/accuracy
-//                                                  # curve (model_resolution.hpp: springs, voxel)
-//
-//   [calibration]                                  # optional: calibrated rows beside the others
-//   clay_pull = ["calibration/clay_pull.springs.toml"]   # parameter files (kerf calibrate -o),
-//                                                  # relative to the study file; every model a file
-//                                                  # calibrates also runs as "MODEL (calibrated)"
-//
-//   [[calibrate]]                                  # optional: a calibration fitted by the study
-//   scene = "clay_pull"                            # a scene of study.scenes
-//   model = "springs"                              # a model of study.models with free parameters
-//   speed = 2.0                                    # the calibration trajectory: the scene's played
-//                                                  # this many times as fast (!= 1): moves faster,
-//                                                  # holds shorter (study_runner.hpp)
-//   max_evaluations = 30                           # model runs of the fit (default 40)
-//   samples = 6                                    # reference solves on the calibration trajectory
-//                                                  # (default: the scene's [reference] samples)
-//   # fitted to the finest reference on the calibration trajectory, then run and scored, as
-//   # "MODEL (calibrated)", on the scene's own trajectory: held out from the fit.
-//
-// Unknown keys and wrong types are errors naming file:line:column, as for scenes.
+// A study file (experiments/studies/NAME.toml): scenes x models x resolutions, the reference's
+// settings and calibrations. Its format — every table and key with its type, default and meaning —
+// is described once, in docs/studies.md ("Study file"); the reader is study_spec.cpp.
 
 #include "experiments/reference_run/reference_fracture.hpp"
 #include "reference/finite_strain_solver.hpp"
@@ -87,7 +46,10 @@ struct StudyReferenceSpec {
     const auto it = scene_refinements.find(scene);
     return it == scene_refinements.end() ? refinements : it->second;
   }
-  int samples = 40; ///< equilibrium solves along each trajectory (evenly spaced samples)
+  /// Output samples of each reference solve, evenly spaced in time over the trajectory; every
+  /// vertex of the motion is solved too (a segment's end, a dwell's start and end), and adaptive
+  /// sampling adds samples where the force or the mode changes (`adaptive`).
+  int samples = 40;
   /// Per-scene sample counts replacing `samples` for the scenes named ([reference] scene_samples =
   /// { NAME = N }): a scene whose force has finer structure (a cut's crack front advancing element
   /// by element) needs more samples for its RMS over the trajectory to converge with the mesh.
@@ -97,6 +59,19 @@ struct StudyReferenceSpec {
     const auto it = scene_samples.find(scene);
     return it == scene_samples.end() ? samples : it->second;
   }
+  /// Adaptive sampling of every reference solve (ReferenceRunSettings::adaptive_force_change): where
+  /// the force leaves the straight line through the samples before it by more than this fraction of
+  /// its peak, or the interaction mode changes, the sample half way is solved first, down to a
+  /// tool travel of 1/40 of the scene's own element size between two samples (the same at every
+  /// mesh level). 0: off. The default, 20 % of the peak, resolves events and kinks (a release on
+  /// the retreat) without chasing the few-percent saw-tooth of a crack front that advances element
+  /// by element (which the verification in time measures instead).
+  double adaptive = 0.2;
+  /// Verification in time (reference_verification.hpp): the finest level solved a second time with
+  /// half the load increment — 2N − 1 requested samples (the N of the first solve among them),
+  /// the adaptive sampling's least travel halved — and the difference of the two profiles reported
+  /// as the sampling uncertainty, beside the mesh's.
+  bool time_verification = true;
   /// Linear solver of each Newton step (reference/finite_strain_solver.hpp): "auto" (direct below
   /// 60 000 DOFs, and above while the Cholesky factor stays small), "direct" (UMFPACK) or "iterative" (PETSc CG + GAMG).
   reference::LinearSolverChoice linear_solver = reference::LinearSolverChoice::automatic;
@@ -141,13 +116,16 @@ struct StudySpec {
   std::map<std::string, std::vector<int>> resolutions;
 };
 
+/// A study file that cannot be used. what() reads "FILE:LINE:COLUMN: KEY: what was expected, got
+/// what was written", as for scene files.
 class StudyError : public std::runtime_error {
 public:
   using std::runtime_error::runtime_error;
 };
 
 /// Reads and validates a study file; scene names resolve against the study file's folder, then
-/// experiments/scenes. Model names must be in the catalogue.
+/// experiments/scenes. Model names must be in the catalogue. Unknown keys, wrong types and values
+/// out of range are StudyErrors.
 StudySpec read_study(const std::filesystem::path& file);
 
 /// The models a parameter file calibrates: the names of its [models.*] tables. Throws StudyError

@@ -32,7 +32,7 @@ constexpr std::pair<const char*, const char*> latex_unicode[] = {
     {"δ", "\\ensuremath{\\delta}"}, {"σ", "\\ensuremath{\\sigma}"}, {"ν", "\\ensuremath{\\nu}"},
     {"η", "\\ensuremath{\\eta}"},   {"μ", "\\ensuremath{\\mu}"},    {"Δ", "\\ensuremath{\\Delta}"},
     {"±", "\\ensuremath{\\pm}"},    {"²", "\\textsuperscript{2}"}, {"°", "\\textdegree{}"},
-    {"…", "\\ldots{}"},           {"∞", "\\ensuremath{\\infty}"},
+    {"…", "\\ldots{}"},           {"∞", "\\ensuremath{\\infty}"},  {"−", "\\ensuremath{-}"},
 };
 
 std::string latex_escape(const std::string& s) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace kerf {
 
@@ -98,6 +99,108 @@ double SegmentLengthInBody::lengths(const Eigen::Vector3d& a, const Eigen::Vecto
     }
     if (end > start) measure += end - start;
     out[r] = measure * segment_length;
+    total += out[r];
+  }
+  return total;
+}
+
+void SegmentLengthInBody::breakpoints_along(const Eigen::Vector3d& a, const Eigen::Vector3d& d, const Eigen::Vector3d& e,
+                                            double s_min, double s_max, std::vector<double>& out) const {
+  // The swept segment's box.
+  Eigen::AlignedBox3d swept;
+  for (const double s : {s_min, s_max}) {
+    swept.extend(a + s * e);
+    swept.extend(a + d + s * e);
+  }
+  const auto keep = [&](double s) {
+    if (std::isfinite(s) && s >= s_min && s <= s_max) out.push_back(s);
+  };
+  m_tree.for_each_overlapping(swept, [&](int t) {
+    const auto ti = static_cast<std::size_t>(t);
+    // Face k: t_k(s) = α_k + β_k s where n·d ≠ 0; a parallel face switches at one s.
+    double alpha[4], beta[4];
+    int affine = 0;
+    for (const Face& f : m_faces[ti]) {
+      const double nd = f.normal.dot(d), ne = f.normal.dot(e);
+      const double r0 = f.offset + m_tolerance[ti] - f.normal.dot(a); // r(s) = r0 − s n·e
+      if (std::abs(nd) <= 1e-15 * d.norm()) {
+        if (ne != 0.0) keep(r0 / ne);
+        continue;
+      }
+      alpha[affine] = r0 / nd;
+      beta[affine] = -ne / nd;
+      ++affine;
+    }
+    for (int k = 0; k < affine; ++k) {
+      if (beta[k] != 0.0) {
+        keep(-alpha[k] / beta[k]);
+        keep((1.0 - alpha[k]) / beta[k]);
+      }
+      for (int m = k + 1; m < affine; ++m)
+        if (beta[k] != beta[m]) keep((alpha[m] - alpha[k]) / (beta[k] - beta[m]));
+    }
+  });
+}
+
+ContactLengthTable::ContactLengthTable(SegmentLengthInBody& body, const Eigen::Vector3d& p0, const Eigen::Vector3d& e,
+                                       const Eigen::Vector3d& half, double s_min, double s_max)
+    : m_body(&body), m_p0(p0), m_e(e), m_half(half), m_regions(body.region_count()) {
+  std::vector<double> candidates{s_min, s_max};
+  body.breakpoints_along(p0 - half, 2.0 * half, e, s_min, s_max, candidates);
+  std::sort(candidates.begin(), candidates.end());
+  for (const double s : candidates)
+    if (m_breakpoints.empty() || s - m_breakpoints.back() > 1e-12) m_breakpoints.push_back(s);
+  if (m_breakpoints.size() < 2) m_breakpoints.push_back(m_breakpoints.back() + 1e-9);
+  const auto regions = static_cast<std::size_t>(m_regions);
+  std::vector<double> l1(regions), l2(regions);
+  const auto measure = [&](double s, std::vector<double>& into) { body.lengths(p0 + s * e - half, p0 + s * e + half, into); };
+  const std::size_t intervals = m_breakpoints.size() - 1;
+  m_value.resize(intervals * regions);
+  m_slope.resize(intervals * regions);
+  for (std::size_t j = 0; j < intervals; ++j) {
+    const double b0 = m_breakpoints[j], width = m_breakpoints[j + 1] - b0;
+    const double q1 = b0 + width / 3.0, q2 = b0 + 2.0 * width / 3.0;
+    measure(q1, l1);
+    measure(q2, l2);
+    for (std::size_t r = 0; r < regions; ++r) {
+      const double slope = (l2[r] - l1[r]) / (q2 - q1);
+      m_slope[j * regions + r] = slope;
+      m_value[j * regions + r] = l1[r] - slope * (q1 - b0);
+    }
+  }
+}
+
+double ContactLengthTable::parameter(const Eigen::Vector3d& p) const noexcept {
+  if (m_breakpoints.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector3d r = p - m_p0;
+  const double s = r.dot(m_e);
+  if ((r - s * m_e).norm() > 1e-12 || s < m_breakpoints.front() || s > m_breakpoints.back())
+    return std::numeric_limits<double>::quiet_NaN();
+  return s;
+}
+
+double ContactLengthTable::lengths(double s, std::span<double> out) noexcept {
+  const auto regions = static_cast<std::size_t>(m_regions);
+  // The interval [b_j, b_{j+1}] holding s: the last one or its neighbours first (a blade moves
+  // a micrometre per sample), else bisection.
+  const std::size_t last = m_breakpoints.size() - 1;
+  std::size_t j = std::min(m_last, last - 1);
+  if (!(m_breakpoints[j] <= s && s <= m_breakpoints[j + 1])) {
+    if (j + 2 <= last && m_breakpoints[j + 1] <= s && s <= m_breakpoints[j + 2]) ++j;
+    else if (j > 0 && m_breakpoints[j - 1] <= s && s <= m_breakpoints[j]) --j;
+    else j = std::clamp<std::size_t>(static_cast<std::size_t>(std::upper_bound(m_breakpoints.begin(), m_breakpoints.end(), s) -
+                                                              m_breakpoints.begin()), 1, last) - 1;
+  }
+  m_last = j;
+  // Next to a breakpoint, where a length may jump: measured on the mesh.
+  if (s - m_breakpoints[j] <= 1e-12 || m_breakpoints[j + 1] - s <= 1e-12) {
+    const Eigen::Vector3d p = m_p0 + s * m_e;
+    return m_body->lengths(p - m_half, p + m_half, out);
+  }
+  double total = 0.0;
+  for (std::size_t r = 0; r < regions; ++r) {
+    // a zero length extrapolated may round below zero
+    out[r] = std::max(m_value[j * regions + r] + m_slope[j * regions + r] * (s - m_breakpoints[j]), 0.0);
     total += out[r];
   }
   return total;

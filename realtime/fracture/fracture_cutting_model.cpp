@@ -45,6 +45,20 @@ FractureCuttingModel::FractureCuttingModel(const TetMesh& mesh, FractureCuttingS
 
   m_lateral_direction = m_setup.blade.edge_direction.cross(m_setup.blade.cutting_direction).normalized();
   m_lengths.assign(static_cast<std::size_t>(m_length.region_count()), 0.0);
+  if (m_setup.cutting_axis_point) {
+    require(m_setup.cutting_axis_point->allFinite(), "the cutting axis point must be finite");
+    // The axis over the body's extent along it, and one edge length beyond either side.
+    const Eigen::Vector3d& e = m_setup.blade.cutting_direction;
+    double lo = INFINITY, hi = -INFINITY;
+    for (Eigen::Index n = 0; n < mesh.nodes.rows(); ++n) {
+      const double s = (mesh.nodes.row(n).transpose() - *m_setup.cutting_axis_point).dot(e);
+      lo = std::min(lo, s);
+      hi = std::max(hi, s);
+    }
+    const double margin = m_setup.blade.edge_length;
+    m_axis = ContactLengthTable(m_length, *m_setup.cutting_axis_point, e, 0.5 * m_setup.blade.edge_length * m_setup.blade.edge_direction,
+                                lo - margin, hi + margin);
+  }
   if (m_setup.friction) {
     require(m_setup.friction_coefficient >= 0.0, "friction coefficient must be >= 0");
     m_friction_x.emplace(r.presliding_stiffness, r.presliding_stick_ratio);
@@ -74,6 +88,9 @@ double FractureCuttingModel::f2_over_toughness(double deflection) const {
 }
 
 double FractureCuttingModel::measure(const Eigen::Vector3d& p) {
+  // On the cutting axis: l(x) as tabulated at construction.
+  if (!m_axis.empty())
+    if (const double s = m_axis.parameter(p); std::isfinite(s)) return m_axis.lengths(s, m_lengths);
   const Eigen::Vector3d half = 0.5 * m_setup.blade.edge_length * m_setup.blade.edge_direction;
   return m_length.lengths(p - half, p + half, m_lengths);
 }

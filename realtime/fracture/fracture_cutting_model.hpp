@@ -35,6 +35,11 @@ struct FractureCuttingSetup {
   /// A new contact within this lateral distance of an existing crack's plane re-enters that
   /// crack (paper 001 Fig. 5: contact inside a crack starts in deformation state 2) [m].
   double crack_capture_width = 0.0;
+  /// A point of the fixed cutting axis the edge's midpoint travels on (a scene's trajectory
+  /// start): l(x) along that axis is computed once, at construction (ContactLengthTable), and
+  /// every position on the axis reads it instead of clipping the edge against the mesh; a
+  /// position off the axis (a hand on the rig) is measured as before. None: always measured.
+  std::optional<Eigen::Vector3d> cutting_axis_point;
 };
 
 /// Paper 001's sharp-interaction model as a state machine (Fig. 11, §4.3):
@@ -58,6 +63,9 @@ public:
   /// Builds the contact-length index on `mesh` (may allocate and take time). Throws
   /// std::invalid_argument on out-of-range parameters, MeshError on missing regions.
   FractureCuttingModel(const TetMesh& mesh, FractureCuttingSetup setup);
+  // The contact-length table measures through this object's own SegmentLengthInBody.
+  FractureCuttingModel(const FractureCuttingModel&) = delete;
+  FractureCuttingModel& operator=(const FractureCuttingModel&) = delete;
 
   [[nodiscard]] std::string_view name() const override { return "fracture"; }
   [[nodiscard]] int tool_count() const override { return 1; }
@@ -88,6 +96,7 @@ private:
   FractureCuttingSetup m_setup;
   Eigen::Vector3d m_lateral_direction; ///< e_y = edge x cutting direction
   SegmentLengthInBody m_length;
+  ContactLengthTable m_axis;           ///< l(x) along the cutting axis (empty without one)
   std::vector<double> m_lengths;       ///< per region, sized once
   std::optional<PreslidingFriction> m_friction_x;
   std::optional<PreslidingFriction> m_friction_y;

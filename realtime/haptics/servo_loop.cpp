@@ -115,11 +115,14 @@ void ServoLoop::step_model(std::span<const ToolState> tools, double dt, std::spa
   const std::int64_t begin = now_ns();
   m_model.step(tools, dt, out);
   compute = 1e-9 * static_cast<double>(now_ns() - begin);
+  // The session report's counts: steps the model flagged, steps longer than their period.
+  bool flagged = false;
+  for (const ForceSample& f : out) flagged = flagged || f.over_budget;
+  m_model_over_budget += flagged ? 1 : 0;
+  m_model_over_period += compute > dt ? 1 : 0;
 }
 
-bool ServoLoop::tick(double now, double late) noexcept {
-  if (m_finished) return false;
-  // 1. Read every device.
+void ServoLoop::read_devices(double now) noexcept {
   bool all_present = true;
   bool button_stop = false;
   for (HapticDevice* d : m_devices) {
@@ -140,16 +143,10 @@ bool ServoLoop::tick(double now, double late) noexcept {
     m_stopping = true;
     for (SafetyLayer& s : m_safety) s.stop(now);
   }
+}
 
-  if (!m_active) { // no state from every device yet: zero commands keep the link open
-    const std::uint32_t status = safety_waiting | (m_emergency ? safety_emergency_stop : 0u);
-    for (HapticDevice* d : m_devices) d->command(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), status, now);
-    if ((m_stopping || m_emergency) && ++m_final_ticks >= final_zero_ticks) m_finished = true;
-    return !m_finished;
-  }
-
-  // 2. Tool states: device positions; velocity by the backward difference (x_k - x_{k-1}) / T.
-  const std::uint64_t k = m_record.tick;
+void ServoLoop::read_tool_states(std::uint64_t k) noexcept {
+  // Device positions; velocity by the backward difference (x_k - x_{k-1}) / T.
   const bool first = k == 0;
   for (std::size_t i = 0; i < m_count; ++i) {
     const Eigen::Vector3d& x = m_devices[i]->state().position;
@@ -157,8 +154,7 @@ bool ServoLoop::tick(double now, double late) noexcept {
     m_tools[i].position = x;
     m_tools[i].time = static_cast<double>(k) * m_period;
   }
-  const bool coupled = m_settings.coupling.stiffness > 0.0;
-  if (coupled) { // the model is given the virtual tool, which starts where the device is
+  if (m_settings.coupling.stiffness > 0.0) { // the model is given the virtual tool, which starts where the device is
     for (std::size_t i = 0; i < m_count; ++i) {
       m_device_tools[i] = m_tools[i];
       if (first) {
@@ -169,39 +165,36 @@ bool ServoLoop::tick(double now, double late) noexcept {
       m_tools[i].velocity = m_virtual_velocity[i];
     }
   }
+}
 
-  // 3. The model: stepped here, or its thread's output interpolated.
-  double compute = 0.0;
-  if (m_settings.model_rate == 0.0) {
-    step_model(m_tools, m_period, m_forces, compute);
-    ++m_model_steps;
-    m_timing.compute.add(compute);
-  } else {
-    ModelInput& in = m_to_model.write_slot();
-    in.time = now;
-    for (std::size_t i = 0; i < m_count; ++i) in.tools[i] = m_tools[i];
-    m_to_model.publish();
-    if (m_from_model.update()) {
-      m_model_previous = m_model_newest;
-      m_model_newest = m_from_model.read_slot();
-    }
-    // First-order hold, one model period behind: F(t) = F_prev + s (F_new - F_prev),
-    // s = (t - t_new) / (t_new - t_prev) in [0, 1]: the force reaches each model output one model
-    // period after it was computed, and never extrapolates.
-    const ModelOutput& a = m_model_previous;
-    const ModelOutput& b = m_model_newest;
-    const double s = (b.time < 0.0 || a.time < 0.0 || b.time <= a.time)
-                         ? 1.0
-                         : std::clamp((now - b.time) / (b.time - a.time), 0.0, 1.0);
-    for (std::size_t i = 0; i < m_count; ++i) {
-      const Eigen::Vector3d fa = a.time < 0.0 ? b.forces[i].force : a.forces[i].force;
-      m_forces[i] = b.forces[i];
-      m_forces[i].force = b.time < 0.0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(fa + s * (b.forces[i].force - fa));
-    }
-    compute = b.compute;
+double ServoLoop::hold_model_output(double now) noexcept {
+  ModelInput& in = m_to_model.write_slot();
+  in.time = now;
+  for (std::size_t i = 0; i < m_count; ++i) in.tools[i] = m_tools[i];
+  m_to_model.publish();
+  if (m_from_model.update()) {
+    m_model_previous = m_model_newest;
+    m_model_newest = m_from_model.read_slot();
   }
+  // First-order hold, one model period behind: F(t) = F_prev + s (F_new - F_prev),
+  // s = (t - t_new) / (t_new - t_prev) in [0, 1]: the force reaches each model output one model
+  // period after it was computed, and never extrapolates.
+  const ModelOutput& a = m_model_previous;
+  const ModelOutput& b = m_model_newest;
+  const double s = (b.time < 0.0 || a.time < 0.0 || b.time <= a.time)
+                       ? 1.0
+                       : std::clamp((now - b.time) / (b.time - a.time), 0.0, 1.0);
+  for (std::size_t i = 0; i < m_count; ++i) {
+    const Eigen::Vector3d fa = a.time < 0.0 ? b.forces[i].force : a.forces[i].force;
+    m_forces[i] = b.forces[i];
+    m_forces[i].force = b.time < 0.0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(fa + s * (b.forces[i].force - fa));
+  }
+  return b.compute;
+}
 
+void ServoLoop::render_forces() noexcept {
   // Rendering: the model's force directly, or through the virtual coupling (VirtualCoupling).
+  const bool coupled = m_settings.coupling.stiffness > 0.0;
   for (std::size_t i = 0; i < m_count; ++i) {
     if (!coupled) {
       m_desired[i] = m_forces[i].force;
@@ -224,11 +217,9 @@ bool ServoLoop::tick(double now, double late) noexcept {
     m_desired[i] = c.stiffness * (x_v - x_d) + c.damping * (v_v - v_d);
     if (!m_forces[i].force.allFinite()) m_desired[i] = m_forces[i].force;
   }
+}
 
-  // 4. Safety, command, passivity observer, record.
-  m_record.t = static_cast<double>(k) * m_period;
-  m_record.compute = compute;
-  m_record.late = late;
+bool ServoLoop::command_devices(double now, bool first) noexcept {
   // The rate limit acts on the real time since the previous tick (longer after an overrun).
   const double elapsed = first ? m_period : std::max(now - m_last_now, 0.0);
   m_last_now = now;
@@ -262,6 +253,41 @@ bool ServoLoop::tick(double now, double late) noexcept {
     r.status = status;
     r.injected = m_injected[i];
   }
+  return all_stopped;
+}
+
+bool ServoLoop::tick(double now, double late) noexcept {
+  if (m_finished) return false;
+  // 1. Read every device.
+  read_devices(now);
+  if (!m_active) { // no state from every device yet: zero commands keep the link open
+    const std::uint32_t status = safety_waiting | (m_emergency ? safety_emergency_stop : 0u);
+    for (HapticDevice* d : m_devices) d->command(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), status, now);
+    if ((m_stopping || m_emergency) && ++m_final_ticks >= final_zero_ticks) m_finished = true;
+    return !m_finished;
+  }
+
+  // 2. Tool states.
+  const std::uint64_t k = m_record.tick;
+  const bool first = k == 0;
+  read_tool_states(k);
+
+  // 3. The model: stepped here, or its thread's output interpolated; the force to render.
+  double compute = 0.0;
+  if (m_settings.model_rate == 0.0) {
+    step_model(m_tools, m_period, m_forces, compute);
+    ++m_model_steps;
+    m_timing.compute.add(compute);
+  } else {
+    compute = hold_model_output(now);
+  }
+  render_forces();
+
+  // 4. Safety, command, passivity observer, record.
+  m_record.t = static_cast<double>(k) * m_period;
+  m_record.compute = compute;
+  m_record.late = late;
+  const bool all_stopped = command_devices(now, first);
   if (m_recorder) m_recorder->push(m_record);
   ++m_record.tick;
   if ((m_emergency || (m_stopping && all_stopped)) && ++m_final_ticks >= final_zero_ticks) m_finished = true;
@@ -320,6 +346,8 @@ ServoReport ServoLoop::run() {
     report.injected_energy.push_back(m_injected[i]);
   }
   report.model_steps = m_model_steps;
+  report.model_steps_over_budget = m_model_over_budget;
+  report.model_steps_over_period = m_model_over_period;
   report.records_dropped = m_recorder ? m_recorder->dropped() : 0;
   report.emergency_stopped = m_emergency;
   return report;

@@ -60,6 +60,11 @@ struct ServoReport {
   std::vector<SafetyCounters> safety;      ///< per device
   std::vector<double> injected_energy;     ///< per device: passivity observer [J]
   std::uint64_t model_steps = 0;
+  /// Model steps that reported themselves over budget (ForceSample::over_budget on any tool: a
+  /// solver that did not converge in its bounded work, a voxel neighbourhood over capacity, …).
+  std::uint64_t model_steps_over_budget = 0;
+  /// Model steps whose compute time exceeded their period (1 / the model's rate).
+  std::uint64_t model_steps_over_period = 0;
   std::uint64_t records_dropped = 0;       ///< ticks the recorder's ring could not take
   bool emergency_stopped = false;
 };
@@ -91,6 +96,9 @@ public:
   [[nodiscard]] const SafetyLayer& safety(std::size_t device) const { return m_safety.at(device); }
   [[nodiscard]] double injected_energy(std::size_t device) const { return m_injected.at(device); }
   [[nodiscard]] std::uint64_t model_steps() const noexcept { return m_model_steps; }
+  /// Model steps so far that reported themselves over budget / took longer than their period.
+  [[nodiscard]] std::uint64_t model_steps_over_budget() const noexcept { return m_model_over_budget; }
+  [[nodiscard]] std::uint64_t model_steps_over_period() const noexcept { return m_model_over_period; }
 
 private:
   /// What the model thread publishes (multi-rate).
@@ -108,6 +116,16 @@ private:
   void servo_thread();
   void model_thread();
   void step_model(std::span<const ToolState> tools, double dt, std::span<ForceSample> out, double& compute) noexcept;
+  /// The steps of `tick`: 1. poll the devices and switch to emergency stop, active or stopping;
+  /// 2. the model's tool states at tick k (a coupled model's: the virtual tools); 3. the
+  /// multi-rate model's output, first-order held (returns its compute time), and the force to
+  /// render (direct or through the virtual coupling); 4. safety, command, passivity observer
+  /// and the tick's record (returns whether every device has stopped with zero force).
+  void read_devices(double now) noexcept;
+  void read_tool_states(std::uint64_t k) noexcept;
+  double hold_model_output(double now) noexcept;
+  void render_forces() noexcept;
+  bool command_devices(double now, bool first) noexcept;
 
   ToolModel& m_model;
   std::vector<HapticDevice*> m_devices;
@@ -137,6 +155,8 @@ private:
   double m_last_now = 0.0;
   bool m_finished = false;
   std::uint64_t m_model_steps = 0;
+  std::uint64_t m_model_over_budget = 0; ///< written by the thread that steps the model, read after it
+  std::uint64_t m_model_over_period = 0;
   std::atomic<bool> m_stop_requested{false};
   std::atomic<bool> m_emergency_requested{false};
   std::atomic<bool> m_model_thread_done{false};

@@ -32,6 +32,141 @@ constexpr std::ptrdiff_t panel_floats(int nscol, int nsrow, int c) {
                                                                       : panel_rows(nscol - c) + panel_rows(nsrow - nscol));
 }
 
+
+/// The free degrees of freedom in natural order: those of the nodes (node order; an axis fixed
+/// by NodeConstraint has none), then, tear-ready, one shadow per free dof of every node.
+struct FreeDofs {
+  std::vector<int> natural;        ///< per entry 3 n + i: the dof of node n's axis i, or −1
+  std::vector<int> shadow_natural; ///< per entry 3 n + i: its shadow's dof, or −1
+  int count = 0;                   ///< dofs and shadows
+  int first_shadow = 0;            ///< the shadows are count − first_shadow dofs from here
+};
+
+FreeDofs number_free_dofs(const SpringNetwork& net, bool tear_ready) {
+  FreeDofs d;
+  d.natural.assign(static_cast<std::size_t>(3 * net.node_capacity()), -1);
+  d.shadow_natural.assign(d.natural.size(), -1);
+  int n = 0;
+  for (int p = 0; p < net.node_count; ++p)
+    for (int i = 0; i < 3; ++i)
+      if (!(net.constraint[static_cast<std::size_t>(p)] & (1u << i))) d.natural[static_cast<std::size_t>(3 * p + i)] = n++;
+  d.first_shadow = n;
+  if (tear_ready)
+    for (int p = 0; p < net.node_count; ++p)
+      for (int i = 0; i < 3; ++i)
+        if (d.natural[static_cast<std::size_t>(3 * p + i)] >= 0) d.shadow_natural[static_cast<std::size_t>(3 * p + i)] = n++;
+  d.count = n;
+  return d;
+}
+
+/// Local dof a (3 corner + axis) of a cell: the node's dof and its shadow's, either may be −1.
+std::array<int, 2> cell_dofs(const SpringNetwork& net, const std::vector<int>& map, const std::vector<int>& shadow, int cell, int a) {
+  const auto k = static_cast<std::size_t>(3 * net.cell_nodes[static_cast<std::size_t>(cell)][static_cast<std::size_t>(a / 3)] + a % 3);
+  return std::array<int, 2>{map[k], shadow[k]};
+}
+
+/// The lower triangle of the n x n cell-coupling pattern (every pair of dofs, or shadows, of
+/// nodes sharing a cell) with dofs numbered by `map` and `shadow`; entries 1.
+NetworkSystem::Matrix lower_pattern(const SpringNetwork& net, const std::vector<int>& map, const std::vector<int>& shadow, int n,
+                                    bool tear_ready) {
+  std::vector<Eigen::Triplet<double, int>> triplets;
+  triplets.reserve(static_cast<std::size_t>(net.cell_count()) * (tear_ready ? 1200 : 300));
+  for (int cell = 0; cell < net.cell_count(); ++cell)
+    for (int a = 0; a < 24; ++a)
+      for (const int r : cell_dofs(net, map, shadow, cell, a)) {
+        if (r < 0) continue;
+        for (int b = 0; b < 24; ++b)
+          for (const int c : cell_dofs(net, map, shadow, cell, b))
+            if (c >= 0 && r >= c) triplets.emplace_back(r, c, 1.0);
+      }
+  NetworkSystem::Matrix m(n, n);
+  m.setFromTriplets(triplets.begin(), triplets.end());
+  m.makeCompressed();
+  return m;
+}
+
+/// Fill-reducing ordering: the lattice's geometric nested dissection (lattice_dissection.hpp;
+/// a node and its shadow take their lattice point's rank, dofs of one point stay together), as
+/// the permutation given to CHOLMOD (entry new = natural dof); empty when a node is off the
+/// block's lattice.
+std::vector<int> lattice_ordering(const SpringNetwork& net, const FreeDofs& dofs) {
+  const int n = dofs.count;
+  std::vector<int> given;
+  const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
+  const std::vector<int> rank = lattice_nested_dissection(np);
+  std::vector<std::int64_t> key(static_cast<std::size_t>(n), -1);
+  bool on_lattice = net.block.cell_size > 0.0;
+  for (int p = 0; p < net.node_count && on_lattice; ++p) {
+    const Eigen::Vector3d g = (net.rest.col(p) - net.block.origin) / net.block.cell_size;
+    const Eigen::Vector3i gi = g.array().round().cast<int>();
+    if ((gi.array() < 0).any() || (gi.array() >= np.array()).any() || (g - gi.cast<double>()).norm() > 1e-6) {
+      on_lattice = false;
+      break;
+    }
+    const std::int64_t r = rank[static_cast<std::size_t>(gi.x() + np.x() * (gi.y() + np.y() * gi.z()))];
+    for (int i = 0; i < 3; ++i)
+      for (const int k : {dofs.natural[static_cast<std::size_t>(3 * p + i)], dofs.shadow_natural[static_cast<std::size_t>(3 * p + i)]})
+        if (k >= 0) key[static_cast<std::size_t>(k)] = r * (2 * static_cast<std::int64_t>(n)) + k;
+  }
+  if (on_lattice) {
+    given.resize(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) given[static_cast<std::size_t>(k)] = k;
+    std::sort(given.begin(), given.end(), [&key](int a, int b) { return key[static_cast<std::size_t>(a)] < key[static_cast<std::size_t>(b)]; });
+  }
+  return given;
+}
+
+/// CHOLMOD's symbolic analysis of the natural `pattern` (lower triangle) for a supernodal
+/// factor: the lattice's ordering `given` (if any) against AMD, CHOLMOD keeping the one with the
+/// smaller factor. Both are deterministic; METIS (CHOLMOD's default tries it when AMD's fill is
+/// high) is not, so it is never tried. `ordering` gets the one kept. The factor's numeric
+/// storage and Common's workspace are allocated now rather than on the first factorisation.
+cholmod_factor* analyse_pattern(cholmod_common& common, NetworkSystem::Matrix& pattern, std::vector<int>& given,
+                                NetworkSystem::FillOrdering& ordering) {
+  cholmod_sparse view = cholmod_view(pattern, -1);
+  common.nmethods = given.empty() ? 1 : 2;
+  common.method[0].ordering = given.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
+  common.method[1].ordering = CHOLMOD_AMD;
+  cholmod_factor* factor = cholmod_analyze_p(&view, given.empty() ? nullptr : given.data(), nullptr, 0, &common);
+  ordering = given.empty() || common.selected == 1 ? NetworkSystem::FillOrdering::amd : NetworkSystem::FillOrdering::lattice_nested_dissection;
+  if (!factor || common.status < CHOLMOD_OK)
+    throw std::runtime_error("NetworkSystem: CHOLMOD analysis failed (status " + std::to_string(common.status) + ")");
+  cholmod_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, factor, &common);
+  cholmod_allocate_work(view.nrow, 2 * view.nrow + 5 * factor->nsuper, 0, &common);
+  if (common.status < CHOLMOD_OK) throw std::runtime_error("NetworkSystem: CHOLMOD workspace allocation failed");
+  return factor;
+}
+
+/// The dofs and shadows renumbered in the factor's order (perm[new] = natural); a shadow is
+/// unused (`in_use` 0) until a copy takes it.
+void number_in_factor_order(const FreeDofs& dofs, const int* perm, std::vector<int>& dof_of, std::vector<int>& shadow_of,
+                            std::vector<std::uint8_t>& in_use) {
+  const int n = dofs.count;
+  std::vector<int> new_of_natural(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) new_of_natural[static_cast<std::size_t>(perm[k])] = k;
+  dof_of.assign(dofs.natural.size(), -1);
+  for (std::size_t k = 0; k < dofs.natural.size(); ++k) {
+    if (dofs.natural[k] >= 0) dof_of[k] = new_of_natural[static_cast<std::size_t>(dofs.natural[k])];
+    if (dofs.shadow_natural[k] >= 0) shadow_of[k] = new_of_natural[static_cast<std::size_t>(dofs.shadow_natural[k])];
+  }
+  for (int k = dofs.first_shadow; k < n; ++k) in_use[static_cast<std::size_t>(new_of_natural[static_cast<std::size_t>(k)])] = 0;
+}
+
+/// The node at each lattice point (−1 if none), for finding the original of a copy (same rest
+/// position); throws if a node is off the block's lattice or two share a point (a torn network).
+std::vector<int> node_at_lattice_point(const SpringNetwork& net) {
+  const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
+  std::vector<int> node_at(static_cast<std::size_t>(np.prod()), -1);
+  for (int p = 0; p < net.node_count; ++p) {
+    const Eigen::Vector3i g = ((net.rest.col(p) - net.block.origin) / net.block.cell_size).array().round().cast<int>();
+    if ((g.array() < 0).any() || (g.array() >= np.array()).any()) throw std::invalid_argument("NetworkSystem: a node off the block's lattice");
+    int& at = node_at[static_cast<std::size_t>(g.x() + np.x() * (g.y() + np.y() * g.z()))];
+    if (at >= 0) throw std::invalid_argument("NetworkSystem: a tear-ready pattern needs an untorn network");
+    at = p;
+  }
+  return node_at;
+}
+
 } // namespace
 
 NetworkSystem::NetworkSystem(SolvePrecision precision) : m_precision(precision) {
@@ -57,6 +192,10 @@ void NetworkSystem::release() noexcept {
   if (m_factor) cholmod_free_factor(&m_factor, m_common);
 }
 
+int NetworkSystem::supernode_count() const { return m_factor ? static_cast<int>(m_factor->nsuper) : 0; }
+
+int NetworkSystem::supernode_start(int s) const { return static_cast<const int*>(m_factor->super)[s]; }
+
 double NetworkSystem::factor_entries() const {
   if (!m_factor) return 0.0;
   return m_factor->is_super ? static_cast<double>(m_factor->xsize) : static_cast<double>(m_factor->nzmax);
@@ -65,127 +204,47 @@ double NetworkSystem::factor_entries() const {
 void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   release();
   m_factorized = false;
-  // Free dofs in node order first, then (tear-ready) one shadow per free dof of every node.
-  std::vector<int> natural(static_cast<std::size_t>(3 * net.node_capacity()), -1);
-  std::vector<int> shadow_natural(natural.size(), -1);
-  int n = 0;
-  for (int p = 0; p < net.node_count; ++p)
-    for (int i = 0; i < 3; ++i)
-      if (!(net.constraint[static_cast<std::size_t>(p)] & (1u << i))) natural[static_cast<std::size_t>(3 * p + i)] = n++;
-  const int first_shadow = n;
-  if (tear_ready)
-    for (int p = 0; p < net.node_count; ++p)
-      for (int i = 0; i < 3; ++i)
-        if (natural[static_cast<std::size_t>(3 * p + i)] >= 0) shadow_natural[static_cast<std::size_t>(3 * p + i)] = n++;
-  // Local dof a (3 corner + axis) of a cell: the node's dof and its shadow's, either may be −1.
-  const auto dofs = [&net](const std::vector<int>& map, const std::vector<int>& shadow, int cell, int a) {
-    const auto k = static_cast<std::size_t>(3 * net.cell_nodes[static_cast<std::size_t>(cell)][static_cast<std::size_t>(a / 3)] + a % 3);
-    return std::array<int, 2>{map[k], shadow[k]};
-  };
-  const auto lower_pattern = [&](const std::vector<int>& map, const std::vector<int>& shadow) {
-    std::vector<Eigen::Triplet<double, int>> triplets;
-    triplets.reserve(static_cast<std::size_t>(net.cell_count()) * (tear_ready ? 1200 : 300));
-    for (int cell = 0; cell < net.cell_count(); ++cell)
-      for (int a = 0; a < 24; ++a)
-        for (const int r : dofs(map, shadow, cell, a)) {
-          if (r < 0) continue;
-          for (int b = 0; b < 24; ++b)
-            for (const int c : dofs(map, shadow, cell, b))
-              if (c >= 0 && r >= c) triplets.emplace_back(r, c, 1.0);
-        }
-    Matrix m(n, n);
-    m.setFromTriplets(triplets.begin(), triplets.end());
-    m.makeCompressed();
-    return m;
-  };
-  m_matrix = lower_pattern(natural, shadow_natural);
+  const FreeDofs dofs = number_free_dofs(net, tear_ready);
+  const int n = dofs.count;
+  m_matrix = lower_pattern(net, dofs.natural, dofs.shadow_natural, n, tear_ready);
   m_bound_cells = net.cell_nodes;
   m_bound_nodes = net.node_count;
   m_node_at_point.clear();
-  m_shadow_of.assign(natural.size(), -1);
+  m_shadow_of.assign(dofs.natural.size(), -1);
   m_dof_in_use.assign(static_cast<std::size_t>(n), 1);
   if (n == 0) {
-    m_dof_of.assign(natural.size(), -1);
+    m_dof_of.assign(dofs.natural.size(), -1);
     m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
     m_diagonal.clear();
     return;
   }
 
   // Ordering and symbolic analysis by CHOLMOD on the natural pattern.
-  cholmod_sparse pattern = cholmod_view(m_matrix, -1);
-  // Fill-reducing ordering: the lattice's geometric nested dissection (lattice_dissection.hpp;
-  // a node and its shadow take their lattice point's rank, dofs of one point stay together)
-  // against AMD, CHOLMOD keeping the one with the smaller factor. Both are deterministic; METIS
-  // (CHOLMOD's default tries it when AMD's fill is high) is not, so it is never tried.
-  std::vector<int> given;
-  {
-    const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
-    const std::vector<int> rank = lattice_nested_dissection(np);
-    std::vector<std::int64_t> key(static_cast<std::size_t>(n), -1);
-    bool on_lattice = net.block.cell_size > 0.0;
-    for (int p = 0; p < net.node_count && on_lattice; ++p) {
-      const Eigen::Vector3d g = (net.rest.col(p) - net.block.origin) / net.block.cell_size;
-      const Eigen::Vector3i gi = g.array().round().cast<int>();
-      if ((gi.array() < 0).any() || (gi.array() >= np.array()).any() || (g - gi.cast<double>()).norm() > 1e-6) {
-        on_lattice = false;
-        break;
-      }
-      const std::int64_t r = rank[static_cast<std::size_t>(gi.x() + np.x() * (gi.y() + np.y() * gi.z()))];
-      for (int i = 0; i < 3; ++i)
-        for (const int k : {natural[static_cast<std::size_t>(3 * p + i)], shadow_natural[static_cast<std::size_t>(3 * p + i)]})
-          if (k >= 0) key[static_cast<std::size_t>(k)] = r * (2 * static_cast<std::int64_t>(n)) + k;
-    }
-    if (on_lattice) {
-      given.resize(static_cast<std::size_t>(n));
-      for (int k = 0; k < n; ++k) given[static_cast<std::size_t>(k)] = k;
-      std::sort(given.begin(), given.end(), [&key](int a, int b) { return key[static_cast<std::size_t>(a)] < key[static_cast<std::size_t>(b)]; });
-    }
-  }
-  m_common->nmethods = given.empty() ? 1 : 2;
-  m_common->method[0].ordering = given.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
-  m_common->method[1].ordering = CHOLMOD_AMD;
-  m_factor = cholmod_analyze_p(&pattern, given.empty() ? nullptr : given.data(), nullptr, 0, m_common);
-  m_ordering = given.empty() || m_common->selected == 1 ? FillOrdering::amd : FillOrdering::lattice_nested_dissection;
-  if (!m_factor || m_common->status < CHOLMOD_OK)
-    throw std::runtime_error("NetworkSystem: CHOLMOD analysis failed (status " + std::to_string(m_common->status) + ")");
-  // Numeric storage of L, and Common's workspace, allocated now rather than on the first factorisation.
-  cholmod_change_factor(CHOLMOD_REAL, 1, 1, 1, 1, m_factor, m_common);
-  cholmod_allocate_work(static_cast<std::size_t>(n), 2 * static_cast<std::size_t>(n) + 5 * m_factor->nsuper, 0, m_common);
-  if (m_common->status < CHOLMOD_OK) throw std::runtime_error("NetworkSystem: CHOLMOD workspace allocation failed");
-  const int* perm = static_cast<const int*>(m_factor->Perm); // perm[new] = natural
-  std::vector<int> new_of_natural(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) new_of_natural[static_cast<std::size_t>(perm[k])] = k;
-  m_dof_of.assign(natural.size(), -1);
-  for (std::size_t k = 0; k < natural.size(); ++k) {
-    if (natural[k] >= 0) m_dof_of[k] = new_of_natural[static_cast<std::size_t>(natural[k])];
-    if (shadow_natural[k] >= 0) m_shadow_of[k] = new_of_natural[static_cast<std::size_t>(shadow_natural[k])];
-  }
-  // Shadows are unused until a copy takes them: a unit diagonal keeps A positive definite.
-  for (int k = first_shadow; k < n; ++k) m_dof_in_use[static_cast<std::size_t>(new_of_natural[static_cast<std::size_t>(k)])] = 0;
-  if (tear_ready) {
-    // The node at each lattice point, for finding the original of a copy (same rest position).
-    const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
-    m_node_at_point.assign(static_cast<std::size_t>(np.prod()), -1);
-    for (int p = 0; p < net.node_count; ++p) {
-      const Eigen::Vector3i g = ((net.rest.col(p) - net.block.origin) / net.block.cell_size).array().round().cast<int>();
-      if ((g.array() < 0).any() || (g.array() >= np.array()).any()) throw std::invalid_argument("NetworkSystem: a node off the block's lattice");
-      int& at = m_node_at_point[static_cast<std::size_t>(g.x() + np.x() * (g.y() + np.y() * g.z()))];
-      if (at >= 0) throw std::invalid_argument("NetworkSystem: a tear-ready pattern needs an untorn network");
-      at = p;
-    }
-  }
+  std::vector<int> given = lattice_ordering(net, dofs);
+  m_factor = analyse_pattern(*m_common, m_matrix, given, m_ordering);
+  number_in_factor_order(dofs, static_cast<const int*>(m_factor->Perm), m_dof_of, m_shadow_of, m_dof_in_use);
+  if (tear_ready) m_node_at_point = node_at_lattice_point(net);
 
   // Lower-triangular pattern in the factor's order, and each cell entry's place in it.
-  m_matrix = lower_pattern(m_dof_of, m_shadow_of);
+  m_matrix = lower_pattern(net, m_dof_of, m_shadow_of, n, tear_ready);
   m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
   for (int cell = 0; cell < net.cell_count(); ++cell) bind_cell(net, cell);
   m_diagonal.assign(static_cast<std::size_t>(n), -1);
   for (int k = 0; k < n; ++k) m_diagonal[static_cast<std::size_t>(k)] = value_index(k, k);
 
+  size_solve_workspaces();
+  // One factorisation of the mass matrix, which must succeed (positive lumped masses).
+  assemble(net, net.rest, 1.0, 0.0);
+  if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
+  m_factorized = false;
+}
+
+void NetworkSystem::size_solve_workspaces() {
   // The solve's workspaces: the rows below the tallest supernode, the widest supernode's dots;
   // single precision: the inverted blocks' panels (four columns each, rows from the panel's
   // first column down) and one column of a block in double.
   if (!m_factor->is_super) throw std::runtime_error("NetworkSystem: CHOLMOD did not choose a supernodal factor");
+  const auto n = static_cast<std::size_t>(m_matrix.rows());
   m_numeric.analyse(supernodal_structure(*m_factor));
   const int* pi = static_cast<const int*>(m_factor->pi);
   const int* super = static_cast<const int*>(m_factor->super);
@@ -209,18 +268,14 @@ void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
   m_inverse_column.assign(single ? 4 * tallest : 0, 0.0);
   m_below.assign(tallest, 0.0);
   m_dots.assign(widest, 0.0);
-  m_inverse_diagonal.assign(static_cast<std::size_t>(n), 0.0);
-  m_solution_single.assign(single ? static_cast<std::size_t>(n) : 0, 0.0f);
+  m_inverse_diagonal.assign(n, 0.0);
+  m_solution_single.assign(single ? n : 0, 0.0f);
   m_rows_single.assign(single ? widest + tallest + 32 : 0, 0.0f);
   m_rows_split = static_cast<int>(widest) + 16;
-  // One factorisation of the mass matrix, which must succeed (positive lumped masses).
-  assemble(net, net.rest, 1.0, 0.0);
-  if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");
-  m_factorized = false;
 }
 
 void NetworkSystem::assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double mass_weight,
-                             double stiffness_weight) noexcept {
+                             double stiffness_weight, CellTangent tangent) noexcept {
   double* values = m_matrix.valuePtr();
   std::fill(values, values + m_matrix.nonZeros(), 0.0);
   Eigen::Matrix<double, 3, 8> xc;
@@ -229,7 +284,7 @@ void NetworkSystem::assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x
     for (int cell = 0; cell < net.cell_count(); ++cell) {
       const auto& nodes = net.cell_nodes[static_cast<std::size_t>(cell)];
       for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
-      cell_stiffness_matrix(net, cell, xc, K);
+      cell_stiffness_matrix(net, cell, xc, K, tangent);
       const int* entry = m_entry.data() + static_cast<std::size_t>(cell) * 576;
       for (int a = 0; a < 24; ++a)
         for (int b = 0; b < 24; ++b)
@@ -247,8 +302,11 @@ void NetworkSystem::assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x
       if (const int d = m_dof_of[static_cast<std::size_t>(3 * p + i)]; d >= 0)
         values[m_diagonal[static_cast<std::size_t>(d)]] += stiffness_weight * net.anchors.stiffness[static_cast<std::size_t>(a)];
   }
-  for (std::size_t d = 0; d < m_dof_in_use.size(); ++d)
-    if (!m_dof_in_use[d]) values[m_diagonal[d]] = 1.0; // an unused shadow: decoupled, solution 0
+  // An unused shadow: decoupled (solution 0), with half its node's diagonal (see the header).
+  for (std::size_t k = 0; k < m_shadow_of.size(); ++k)
+    if (const int d = m_shadow_of[k]; d >= 0 && !m_dof_in_use[static_cast<std::size_t>(d)])
+      values[m_diagonal[static_cast<std::size_t>(d)]] =
+          std::max(0.5 * values[m_diagonal[static_cast<std::size_t>(m_dof_of[k])]], 1e-300);
 }
 
 int NetworkSystem::value_index(int r, int c) const noexcept {
@@ -431,8 +489,8 @@ void invert_supernode_blocks(const cholmod_factor& L, const double* lx, const do
 ///   r = W y_s, y_s ← r_top, y_b += r_below;   x_s ← Wᵀ [x_s; x_b].
 /// `top` has room for the widest supernode and 16 more, `bottom` for the tallest and 16 more.
 KERF_VECTOR_CLONES
-void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std::ptrdiff_t* at, float* x, float* top,
-                         float* bottom) noexcept {
+void inverse_block_forward(const cholmod_factor& L, const float* blocks, const std::ptrdiff_t* at, float* x, float* top,
+                           float* bottom, bool skip_zero) noexcept {
   const int* super = static_cast<const int*>(L.super);
   const int* pi = static_cast<const int*>(L.pi);
   const int* ls = static_cast<const int*>(L.s);
@@ -443,6 +501,7 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
     const int k1 = super[s], nscol = super[s + 1] - k1, psi = pi[s], m = pi[s + 1] - psi - nscol;
     const int pb = panel_rows(m);
     float* xs = x + k1;
+    if (skip_zero && std::all_of(xs, xs + nscol, [](float v) { return v == 0.0f; })) continue; // nothing to carry down
     // x_s's entry j, zero past the supernode's last column (a panel pass takes four columns)
     const auto xj = [xs, nscol](int j) { return j < nscol ? xs[j] : 0.0f; };
     if (whole_inverted_block(nscol)) {
@@ -488,6 +547,17 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
 #pragma omp simd
     for (int i = 0; i < m; ++i) x[below[i]] -= bottom[i];
   }
+}
+
+/// The backward half of inverse_block_solve: Lᵀ x = y in place.
+KERF_VECTOR_CLONES
+void inverse_block_backward(const cholmod_factor& L, const float* blocks, const std::ptrdiff_t* at, float* x, float* top,
+                            float* bottom) noexcept {
+  const int* super = static_cast<const int*>(L.super);
+  const int* pi = static_cast<const int*>(L.pi);
+  const int* ls = static_cast<const int*>(L.s);
+  const auto nsuper = static_cast<int>(L.nsuper);
+  const auto column = [](const float* p, int t, int stride) { return p + static_cast<std::ptrdiff_t>(t) * stride; };
   // Backward: Lᵀ x = y.
   float d[4];
   for (int s = nsuper - 1; s >= 0; --s) {
@@ -537,6 +607,14 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
       panel += 4 * static_cast<std::ptrdiff_t>(stride);
     }
   }
+}
+
+/// L y = b then Lᵀ x = y in place on x (single precision): inverse_block_forward, then
+/// inverse_block_backward.
+void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std::ptrdiff_t* at, float* x, float* top,
+                         float* bottom) noexcept {
+  inverse_block_forward(L, blocks, at, x, top, bottom, false);
+  inverse_block_backward(L, blocks, at, x, top, bottom);
 }
 
 } // namespace
@@ -715,6 +793,22 @@ void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noex
   for (int k = 0; k < n; ++k) m_solution_single[static_cast<std::size_t>(k)] = static_cast<float>(rhs[k]);
   solve_in_place();
   for (int k = 0; k < n; ++k) out[k] = static_cast<double>(m_solution_single[static_cast<std::size_t>(k)]);
+}
+
+bool NetworkSystem::forward_solve_in_place(float* y) noexcept {
+  if (m_precision != SolvePrecision::single_precision) return false;
+  if (dof_count() == 0) return true;
+  inverse_block_forward(*m_factor, m_inverse_blocks.data() + m_inverse_align, m_inverse_block_at.data(), y, m_rows_single.data(),
+                        m_rows_single.data() + m_rows_split, true);
+  return true;
+}
+
+bool NetworkSystem::backward_solve_in_place(float* x) noexcept {
+  if (m_precision != SolvePrecision::single_precision) return false;
+  if (dof_count() == 0) return true;
+  inverse_block_backward(*m_factor, m_inverse_blocks.data() + m_inverse_align, m_inverse_block_at.data(), x, m_rows_single.data(),
+                         m_rows_single.data() + m_rows_split);
+  return true;
 }
 
 bool NetworkSystem::solve_in_place() noexcept {

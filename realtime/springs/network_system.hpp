@@ -76,8 +76,14 @@ public:
   /// Free dof of node n's axis i (entry 3 n + i), or -1 when fixed; in the factor's ordering.
   [[nodiscard]] const std::vector<int>& dof_of() const { return m_dof_of; }
 
-  /// A = mass_weight M + stiffness_weight K_T(x) (K_T from cell_stiffness_matrix, lumped M).
-  void assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double mass_weight, double stiffness_weight) noexcept;
+  /// A = mass_weight M + stiffness_weight K_T(x) (K_T from cell_stiffness_matrix with `tangent`,
+  /// lumped M). An unused shadow (tear-ready) gets half its node's diagonal and no coupling: any
+  /// positive value leaves the solution unchanged (its equation is decoupled, its right-hand
+  /// side zero), and this one makes the factor a fair approximation of the system after the
+  /// node splits (each half of its cells takes about half of its diagonal), for a factor kept
+  /// across a split (NewtonStepper).
+  void assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double mass_weight, double stiffness_weight,
+                CellTangent tangent = CellTangent::projected) noexcept;
   /// Numeric supernodal LLᵀ of the assembled A on the analysed pattern (SupernodalCholesky on
   /// the matrix already in the factor's order, OpenBLAS on one thread; allocation-free). False
   /// if A is not positive definite.
@@ -101,9 +107,24 @@ public:
   /// SolvePrecision::double_precision.
   [[nodiscard]] float* single_precision_vector() noexcept { return m_solution_single.data(); }
   bool solve_in_place() noexcept;
+  /// SolvePrecision::single_precision: the forward half of `solve_in_place` alone, y ← L⁻¹ y,
+  /// on a caller's vector of dof_count() floats (in the factor's order; `y` needs room for 16
+  /// more). Supernodes whose part of y is zero on entry to them are skipped, so a sparse y
+  /// costs only the supernodes on its elimination-tree paths. False with double precision.
+  bool forward_solve_in_place(float* y) noexcept;
+  /// The backward half, x ← L⁻ᵀ x, on a caller's vector as for `forward_solve_in_place`.
+  bool backward_solve_in_place(float* x) noexcept;
 
-  /// The assembled matrix (lower triangle stored).
+  /// The assembled matrix (lower triangle stored): after `factorize`, the matrix the factor is of.
   [[nodiscard]] const Matrix& matrix() const { return m_matrix; }
+  /// Entry (d, d) of the assembled matrix.
+  [[nodiscard]] double diagonal(int d) const { return m_matrix.valuePtr()[m_diagonal[static_cast<std::size_t>(d)]]; }
+  /// The factor's supernodes: their count, and the first column of each (supernode_start(count)
+  /// = dof_count()).
+  [[nodiscard]] int supernode_count() const;
+  [[nodiscard]] int supernode_start(int s) const;
+  /// Nodes bound so far (rebuild, then each `bind_split_vertices`).
+  [[nodiscard]] int bound_nodes() const { return m_bound_nodes; }
   /// Entries of the factor L (0 before `rebuild`).
   [[nodiscard]] double factor_entries() const;
 
@@ -114,6 +135,8 @@ private:
   /// The value slots of one cell's 24 x 24 entries from its current corners; false if one is
   /// missing from the pattern.
   bool bind_cell(const SpringNetwork& net, int cell) noexcept;
+  /// Sizes the numeric factorisation's and the solve's workspaces for the analysed factor (`rebuild`).
+  void size_solve_workspaces();
 
   std::vector<int> m_dof_of;
   Matrix m_matrix;

@@ -1,28 +1,49 @@
 #include "realtime/springs/newton_stepper.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace kerf {
 
+namespace {
+/// Anderson mixing keeps at most this many differences (the workspace's width).
+constexpr int max_anderson_depth = 8;
+/// Armijo's sufficient-decrease constant (Nocedal & Wright, Numerical Optimization, §3.1).
+constexpr double armijo = 1e-4;
+} // namespace
+
 NewtonStepper::NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations, double relative_tolerance,
-                             bool tear_ready)
-    : m_mode(mode), m_max_iterations(max_iterations),
-      // Backward Euler's A = M/h² + … is well conditioned (the mass term), so its kept factor is
-      // read in single precision; the quasi-static K_T (regularised by 10⁻⁸ M only) is not.
-      m_system(mode != Mode::quasi_static ? NetworkSystem::SolvePrecision::single_precision
-                                          : NetworkSystem::SolvePrecision::double_precision),
-      m_tolerance_ratio(relative_tolerance), m_tear_ready(tear_ready) {
+                             bool tear_ready, FactorRefreshPolicy policy)
+    : m_mode(mode), m_max_iterations(max_iterations), m_policy(policy), m_tolerance_ratio(relative_tolerance),
+      m_tear_ready(tear_ready) {
   if (max_iterations < 1) throw std::invalid_argument("NewtonStepper: max_iterations must be >= 1");
   if (!(relative_tolerance > 0.0)) throw std::invalid_argument("NewtonStepper: the relative tolerance must be > 0");
+  if (policy.anderson_depth < 0 || policy.anderson_depth > max_anderson_depth)
+    throw std::invalid_argument("NewtonStepper: the Anderson depth must be in [0, 8]");
+  // Backward Euler's A = M/h² + … is well conditioned (the mass term), so its kept factor is
+  // read in single precision; the quasi-static K (regularised by 10⁻⁸ M only) is not.
+  const auto precision = mode != Mode::quasi_static ? NetworkSystem::SolvePrecision::single_precision
+                                                    : NetworkSystem::SolvePrecision::double_precision;
+  for (auto& s : m_systems) s = std::make_unique<NetworkSystem>(precision);
+  if (mode == Mode::implicit_euler) m_refresh = std::make_unique<FactorRefresh>();
   rebuild(net);
 }
 
 void NewtonStepper::rebuild(const SpringNetwork& net) {
+  if (m_refresh) {
+    m_refresh->wait();
+    if (m_refresh->busy()) m_refresh->collect(); // drop it: the pattern changes
+  }
   // Tear-ready only on an untorn network (one still on its lattice); a rebuild after a split
-  // that did not fit is plain.
-  m_system.rebuild(net, m_tear_ready && LatticeForces(net).applies(net));
+  // that did not fit is plain. Both systems get the same (deterministic) analysis.
+  const bool tear_ready = m_tear_ready && LatticeForces(net).applies(net);
+  for (auto& s : m_systems) s->rebuild(net, tear_ready);
+  m_active = 0;
+  if (m_refresh) m_refresh->reserve(net);
+  m_correction.reserve(active().dof_count());
   m_forces = LatticeForces(net);
   const int cap = net.node_capacity();
   m_x0.setZero(3, cap);
@@ -34,25 +55,137 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_free_dof.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_mass.assign(3 * static_cast<std::size_t>(cap), 0.0);
   m_free_lattice.assign(3 * static_cast<std::size_t>(cap), 0);
-  m_r.setZero(m_system.dof_count());
-  m_dx.setZero(m_system.dof_count());
+  m_r.setZero(active().dof_count());
+  m_dx.setZero(active().dof_count());
+  for (Eigen::VectorXd* w : {&m_u, &m_g, &m_u_previous, &m_g_previous, &m_u_next}) w->setZero(3 * cap);
+  m_du.setZero(3 * cap, std::max(m_policy.anderson_depth, 1));
+  m_dg.setZero(3 * cap, std::max(m_policy.anderson_depth, 1));
   bind_free_entries(net);
   m_factor_dt = -1.0;
+  m_splits = 0;
   // Quasi-static regulariser: 1e-8 of the stiffness-to-mass scale k₁ / (cell mass / 8).
   m_static_regularisation = 1e-8 * net.stiffness.edge / (net.cell_mass / 8.0);
 }
 
-bool NewtonStepper::retopologise(const SpringNetwork& net) noexcept {
-  if (!m_system.bind_split_vertices(net)) return false;
-  bind_free_entries(net);
-  m_factor_dt = -1.0;
+double NewtonStepper::mass_weight(double dt) const { return m_mode == Mode::quasi_static ? m_static_regularisation : 1.0 / (dt * dt); }
+
+double NewtonStepper::stiffness_weight(const SpringNetwork& net, double dt) const {
+  return m_mode == Mode::quasi_static ? 1.0 : 1.0 + net.damping_time / dt;
+}
+
+bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
+  const double wm = mass_weight(dt), wk = stiffness_weight(net, dt);
+  CellTangent tangent = m_tear_ready ? CellTangent::projected : CellTangent::exact;
+  active().assemble(net, x, wm, wk, tangent);
+  bool ok = active().factorize();
+  if (!ok && tangent == CellTangent::exact) {
+    tangent = CellTangent::projected;
+    active().assemble(net, x, wm, wk, tangent);
+    ok = active().factorize();
+  }
+  if (!ok) return false;
+  m_factor_dt = dt;
+  m_factor_tangent = tangent;
+  m_factor_mass_weight = wm;
+  m_factor_stiffness_weight = wk;
+  m_correction.clear();
+  m_uncorrected = false;
   return true;
+}
+
+bool NewtonStepper::prime(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
+  if (m_refresh) {
+    m_refresh->wait();
+    if (m_refresh->busy()) m_refresh->collect();
+  }
+  return refactor(net, x, dt);
+}
+
+bool NewtonStepper::retopologise(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept {
+  const int first_copy = active().bound_nodes();
+  if (!active().bind_split_vertices(net)) return false;
+  bind_free_entries(net);
+  if (m_mode != Mode::implicit_euler) {
+    m_factor_dt = -1.0; // refactorised at the next advance
+    return true;
+  }
+  // The kept factor is of the matrix before these splits: correct it for each (the copy has
+  // its original's rest position; their masses add up to the original's before the split).
+  for (int copy = first_copy; copy < net.node_count; ++copy) {
+    int original = -1;
+    for (int p = 0; p < first_copy && original < 0; ++p)
+      if (net.rest.col(p) == net.rest.col(copy)) original = p;
+    const long index = ++m_splits;
+    RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)];
+    r = RecordedSplit{index, original, copy,
+                      original >= 0 ? net.mass[static_cast<std::size_t>(original)] + net.mass[static_cast<std::size_t>(copy)] : 0.0};
+    // Full (or H singular): the kept factor stays uncorrected for this split until a refresh;
+    // Newton then converges more slowly (and says so when it does not).
+    if (!correct_for_split(net, x, index)) m_uncorrected = true;
+  }
+  // A fresh factor of the torn network (if none is being computed: that one is corrected for
+  // this split when adopted).
+  if (m_factor_dt > 0.0) request_refresh(net, x, m_factor_dt);
+  return true;
+}
+
+bool NewtonStepper::correct_for_split(const SpringNetwork& net, const Eigen::Matrix3Xd& x, long index) noexcept {
+  const RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)];
+  if (r.index != index || r.original < 0 || m_factor_dt < 0.0) return false;
+  // The splits made after this one (when corrected for after them): their copies' corners are
+  // taken back at their originals.
+  SplitCorrection::NodePair later[SplitCorrection::max_splits];
+  int later_count = 0;
+  for (long k = index + 1; k <= m_splits && later_count < SplitCorrection::max_splits; ++k) {
+    const RecordedSplit& l = m_recent[static_cast<std::size_t>(k % SplitCorrection::max_splits)];
+    if (l.index == k) later[later_count++] = {l.copy, l.original};
+  }
+  return m_correction.add(active(), net, x, r.original, r.copy, r.mass_before, m_factor_mass_weight, m_factor_stiffness_weight,
+                          m_factor_tangent, later, later_count);
+}
+
+void NewtonStepper::request_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
+  if (!m_refresh || m_refresh->busy()) return;
+  const double wm = mass_weight(dt), wk = stiffness_weight(net, dt);
+  if (m_refresh->start(*m_systems[static_cast<std::size_t>(1 - m_active)], net, x, wm, wk, m_splits,
+                       m_tear_ready ? CellTangent::projected : CellTangent::exact)) {
+    m_job_call = m_calls;
+    m_job_dt = dt;
+    m_job_mass_weight = wm;
+    m_job_stiffness_weight = wk;
+  }
+}
+
+void NewtonStepper::collect_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, NewtonReport& report) noexcept {
+  if (!m_refresh || !m_refresh->busy()) return;
+  if (m_policy.delay >= 0) {
+    if (m_calls < m_job_call + m_policy.delay) return;
+    m_refresh->wait(); // deterministic: this call adopts it, however long the worker took
+  } else if (!m_refresh->finished()) {
+    return;
+  }
+  const FactorRefresh::Result result = m_refresh->collect();
+  if (!result.factorised) return;
+  m_active = 1 - m_active;
+  m_factor_dt = m_job_dt;
+  m_factor_tangent = result.tangent;
+  m_factor_mass_weight = m_job_mass_weight;
+  m_factor_stiffness_weight = m_job_stiffness_weight;
+  m_correction.clear();
+  m_uncorrected = false;
+  ++report.refreshes;
+  // Splits made while it was computed: bound now, and corrected for.
+  if (result.tag < m_splits) {
+    active().bind_split_vertices(net);
+    for (long index = result.tag + 1; index <= m_splits; ++index)
+      if (!correct_for_split(net, x, index)) m_uncorrected = true;
+  }
 }
 
 void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
   // Sized for every entry of the capacity (3 x capacity) at rebuild: binding after a split
   // only rewrites them.
-  const auto& dof = m_system.dof_of();
+  const auto& dof = active().dof_of();
   const bool lattice = m_forces.applies(net);
   m_free_count = 0;
   for (int p = 0; p < net.node_count; ++p)
@@ -66,13 +199,9 @@ void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
       }
 }
 
-bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
-  if (m_mode != Mode::quasi_static)
-    m_system.assemble(net, x, 1.0 / (dt * dt), 1.0 + net.damping_time / dt);
-  else
-    m_system.assemble(net, x, m_static_regularisation, 1.0);
-  m_factor_dt = dt;
-  return m_system.factorize();
+void NewtonStepper::write_free(const Eigen::VectorXd& u, Eigen::Matrix3Xd& x) const noexcept {
+  double* X = x.data();
+  for (int k = 0; k < m_free_count; ++k) X[m_free_entry[static_cast<std::size_t>(k)]] = u[k];
 }
 
 double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
@@ -94,18 +223,36 @@ double NewtonStepper::residual(const SpringNetwork& net, const Eigen::Matrix3Xd&
   else
     for (int k = 0; k < m_free_count; ++k) V[m_free_entry[static_cast<std::size_t>(k)]] = 0.0;
   // Quasi-static equilibrium has no damping: forces at zero velocity.
-  m_forces.evaluate(net, x, implicit ? v : m_zero, m_f, precision);
+  const double energy = m_forces.evaluate(net, x, implicit ? v : m_zero, m_f, precision);
   const double* F = m_f.data();
-  double norm = 0.0;
+  double norm = 0.0, inertia = 0.0;
   for (int k = 0; k < m_free_count; ++k) {
     const int e = m_free_entry[static_cast<std::size_t>(k)];
     // implicit: r = M (x − xₙ − h vₙ)/h² − f;  quasi-static: r = −f
     double r = -F[e];
-    if (implicit) r += m_free_mass[static_cast<std::size_t>(k)] * (X[e] - X0[e] - dt * V0[e]) * inverse_dt2;
+    if (implicit) {
+      const double m = m_free_mass[static_cast<std::size_t>(k)], d = X[e] - X0[e] - dt * V0[e];
+      r += m * d * inverse_dt2;
+      inertia += 0.5 * m * d * d * inverse_dt2;
+    }
     m_r[m_free_dof[static_cast<std::size_t>(k)]] = r;
     norm = std::max(norm, std::abs(r));
   }
+  // The step's incremental potential, ½ |x − xₙ − h vₙ|²_M / h² + W(x), whose gradient is the
+  // residual without the damping forces: the line search's second criterion.
+  m_potential = energy + inertia;
   return norm;
+}
+
+NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept {
+  ++m_calls;
+  switch (m_mode) {
+  case Mode::quasi_static: return advance_static(net, x, v, dt);
+  case Mode::linearly_implicit_euler:
+    return m_forces.applies(net) ? advance_linearised_on_lattice(net, x, v, dt) : advance_linearised(net, x, v, dt);
+  case Mode::implicit_euler: break;
+  }
+  return advance_implicit(net, x, v, dt);
 }
 
 NewtonReport NewtonStepper::advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
@@ -125,21 +272,22 @@ NewtonReport NewtonStepper::advance_linearised_on_lattice(const SpringNetwork& n
     V0[e] = V[e];
     X[e] += dt * V[e];
   }
-  bool fresh = false;
-  if (m_factor_dt != dt) {
+  // Never primed, a new dt, or a check found the kept factor stale: a fresh one at this
+  // predictor, on this thread (the linearised step has no iteration to bridge a stale factor).
+  if (m_factor_dt != dt || m_refresh_pending) {
     if (!refactor(net, x, dt)) {
       report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
       return report;
     }
     ++report.factorisations;
-    fresh = true;
+    m_refresh_pending = false;
   }
   // r(x*) = M (x* − xₙ − h vₙ)/h² − f(x*, v*) = −f(x*, vₙ): v* = (x* − xₙ)/h = vₙ on the free
   // entries (the fixed ones hold their prescribed velocities), and the inertia term vanishes.
   // The forces in single precision on the lattice, straight into the solve's vector.
   m_forces.evaluate_on_lattice(net, x, v);
   const float* F = m_forces.single_forces();
-  float* b = m_system.single_precision_vector();
+  float* b = active().single_precision_vector();
   float largest = 0.0f;
   for (int k = 0; k < m_free_count; ++k) {
     const float f = F[lattice[k]];
@@ -147,19 +295,8 @@ NewtonReport NewtonStepper::advance_linearised_on_lattice(const SpringNetwork& n
     largest = std::max(largest, std::abs(f));
   }
   const double norm = largest;
-  // A kept factorisation that a check found stale is refreshed at this predictor (see advance).
-  if (m_refresh_pending && !fresh) {
-    if (!refactor(net, x, dt)) {
-      // A not positive definite at x*: no step this sample (the state stays at the predictor,
-      // v = vₙ, reported unconverged), the refresh is tried again at the next.
-      report.residual = norm;
-      return report;
-    }
-    ++report.factorisations;
-  }
-  m_refresh_pending = false;
   // A y = f(x*) = −r(x*):  x = x* + y,  v = (x − xₙ)/h = vₙ + y/h.
-  m_system.solve_in_place();
+  active().solve_in_place();
   const double inverse_dt = 1.0 / dt;
   bool finite = true;
   for (int k = 0; k < m_free_count; ++k) {
@@ -180,23 +317,197 @@ NewtonReport NewtonStepper::advance_linearised_on_lattice(const SpringNetwork& n
   return report;
 }
 
-NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
-                                    double dt) noexcept {
-  if (m_mode == Mode::linearly_implicit_euler && m_forces.applies(net)) return advance_linearised_on_lattice(net, x, v, dt);
+NewtonReport NewtonStepper::advance_linearised(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
+                                               double dt) noexcept {
   NewtonReport report;
   const int n = net.node_count;
   m_x0.leftCols(n) = x.leftCols(n);
   m_v0.leftCols(n) = v.leftCols(n);
-  const bool implicit = m_mode != Mode::quasi_static;
-  // Warm start: the implicit step starts from the explicit predictor xₙ + h vₙ.
-  if (implicit)
+  for (int k = 0; k < m_free_count; ++k) {
+    const int e = m_free_entry[static_cast<std::size_t>(k)];
+    x.data()[e] += dt * v.data()[e];
+  }
+  if (m_factor_dt != dt || m_refresh_pending) {
+    if (!refactor(net, x, dt)) {
+      report.residual = residual(net, x, v, dt);
+      return report;
+    }
+    ++report.factorisations;
+    m_refresh_pending = false;
+  }
+  const double tolerance = m_tolerance_ratio * net.stiffness.edge * net.block.cell_size;
+  const double norm = residual(net, x, v, dt, LatticeForces::ForcePrecision::single_precision);
+  // x = x* − A⁻¹ r(x*), v = (x − xₙ)/h: one linear solve.
+  active().solve(m_r, m_dx);
+  for (int k = 0; k < m_free_count; ++k) {
+    const int e = m_free_entry[static_cast<std::size_t>(k)];
+    x.data()[e] -= m_dx[m_free_dof[static_cast<std::size_t>(k)]];
+  }
+  report.iterations = 1;
+  report.residual = norm;
+  if (++m_calls_since_check >= linearised_check_interval) {
+    m_calls_since_check = 0;
+    report.residual = residual(net, x, v, dt); // also sets v
+    m_refresh_pending = report.residual > tolerance && report.residual > 0.25 * norm;
+  } else {
     for (int k = 0; k < m_free_count; ++k) {
       const int e = m_free_entry[static_cast<std::size_t>(k)];
-      x.data()[e] += dt * v.data()[e];
+      v.data()[e] = (x.data()[e] - m_x0.data()[e]) * (1.0 / dt);
     }
+  }
+  report.converged = x.leftCols(n).allFinite();
+  return report;
+}
+
+// One function beyond ~80 lines: the iteration's steps share its state (the accepted iterate,
+// the Anderson history, whether the iterate's potential is double precision).
+NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
+                                             double dt) noexcept {
+  NewtonReport report;
+  collect_refresh(net, x, report);
+  const int n = net.node_count;
+  const int m = m_free_count;
+  m_x0.leftCols(n) = x.leftCols(n);
+  m_v0.leftCols(n) = v.leftCols(n);
+  // Warm start: the explicit predictor xₙ + h vₙ.
+  for (int k = 0; k < m; ++k) {
+    const int e = m_free_entry[static_cast<std::size_t>(k)];
+    x.data()[e] += dt * v.data()[e];
+  }
+  if (m_factor_dt < 0.0 || m_uncorrected) {
+    // Never primed, or a split the correction could not take (more splits than it holds before a
+    // refresh came): factorise here (the one factorisation a servo step may make).
+    if (m_refresh) {
+      m_refresh->wait();
+      if (m_refresh->busy()) m_refresh->collect(); // its system is about to be reused
+    }
+    if (!refactor(net, x, dt)) {
+      report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
+      return report;
+    }
+    ++report.factorisations;
+  } else if (m_factor_dt != dt || m_correction.splits() > 0) {
+    // A new dt, or splits the kept factor is only corrected for: a fresh factor (if none is
+    // being computed already).
+    request_refresh(net, x, dt);
+    collect_refresh(net, x, report);
+  }
+  const double tolerance = m_tolerance_ratio * net.stiffness.edge * net.block.cell_size;
+  // The predictor's residual only sets the first step (an approximate one already: the kept
+  // factor, read in single precision), so its forces are evaluated in single precision; every
+  // residual that decides convergence or a line-search step is double.
+  double norm = residual(net, x, v, dt, LatticeForces::ForcePrecision::single_precision);
+  // Off the lattice (after a tear) the forces are double precision whatever was asked.
+  bool potential_is_double = !m_forces.applies(net);
+  if (norm <= tolerance && !potential_is_double) { // converged already: decide in double
+    norm = residual(net, x, v, dt);
+    potential_is_double = true;
+  }
+  for (int k = 0; k < m; ++k) m_u[k] = x.data()[m_free_entry[static_cast<std::size_t>(k)]];
+  const int depth = m_policy.anderson_depth;
+  int history = 0, slot = 0;
+  bool have_previous = false;
+  while (report.iterations < m_max_iterations && norm > tolerance) {
+    // The kept-factor step g = −Q⁻¹ r (Q: the kept factor corrected for the pending splits).
+    m_correction.solve(active(), m_r, m_dx);
+    ++report.iterations;
+    double slope = 0.0; // r · g: the potential's directional derivative along g (without damping)
+    for (int k = 0; k < m; ++k) {
+      const double g = -m_dx[m_free_dof[static_cast<std::size_t>(k)]];
+      m_g[k] = g;
+      slope += m_r[m_free_dof[static_cast<std::size_t>(k)]] * g;
+    }
+    // Anderson mixing (Walker & Ni, "Anderson acceleration for fixed-point iterations", SIAM J.
+    // Numer. Anal. 49(4), 2011): with the differences ΔU, ΔG of the last iterates and steps,
+    //   γ = argmin |g − ΔG γ|₂,   u ← u + g − (ΔU + ΔG) γ,
+    // the kept-factor iteration's GMRES-like acceleration (its error contracts by the kept
+    // factor's mismatch per step otherwise).
+    m_u_next.head(m) = m_u.head(m) + m_g.head(m);
+    bool mixed = false;
+    if (depth > 0 && have_previous) {
+      m_du.col(slot).head(m) = m_u.head(m) - m_u_previous.head(m);
+      m_dg.col(slot).head(m) = m_g.head(m) - m_g_previous.head(m);
+      slot = (slot + 1) % depth;
+      history = std::min(history + 1, depth);
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, max_anderson_depth, max_anderson_depth> gram(history, history);
+      Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_anderson_depth, 1> rhs(history);
+      for (int i = 0; i < history; ++i) {
+        rhs[i] = m_dg.col(i).head(m).dot(m_g.head(m));
+        for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = m_dg.col(i).head(m).dot(m_dg.col(j).head(m));
+      }
+      // Tikhonov regularisation of the normal equations at 10⁻¹⁰ of their scale.
+      gram.diagonal().array() += 1e-10 * gram.diagonal().maxCoeff() + 1e-300;
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_anderson_depth, 1> gamma = gram.ldlt().solve(rhs);
+      if (gamma.allFinite()) {
+        for (int i = 0; i < history; ++i) m_u_next.head(m) -= gamma[i] * (m_du.col(i).head(m) + m_dg.col(i).head(m));
+        mixed = true;
+      }
+    }
+    double mixed_slope = slope;
+    if (mixed) {
+      mixed_slope = 0.0;
+      for (int k = 0; k < m; ++k) mixed_slope += m_r[m_free_dof[static_cast<std::size_t>(k)]] * (m_u_next[k] - m_u[k]);
+    }
+    m_u_previous.head(m) = m_u.head(m);
+    m_g_previous.head(m) = m_g.head(m);
+    have_previous = true;
+    const double potential = m_potential;
+    // Accepted: a lower residual, or (from a double-precision potential) Armijo's decrease of
+    // the potential along a descent direction (through a snap-through the residual may have to
+    // rise on the way to the other branch's equilibrium).
+    const auto accepted = [&](double trial, double alpha, double s) {
+      return trial < norm || (potential_is_double && s < 0.0 && m_potential <= potential + armijo * alpha * s);
+    };
+    write_free(m_u_next, x);
+    double trial = residual(net, x, v, dt);
+    if (accepted(trial, 1.0, mixed_slope)) {
+      norm = trial;
+      potential_is_double = true;
+      m_u.head(m) = m_u_next.head(m);
+      continue;
+    }
+    // Backtracking along the plain step g (the mixing's history restarts).
+    history = 0;
+    slot = 0;
+    have_previous = false;
+    bool found = false;
+    for (double alpha = mixed ? 1.0 : 0.5; alpha >= 1.0 / 32.0; alpha *= 0.5) {
+      m_u_next.head(m) = m_u.head(m) + alpha * m_g.head(m);
+      write_free(m_u_next, x);
+      trial = residual(net, x, v, dt);
+      if (accepted(trial, alpha, slope)) {
+        found = true;
+        break;
+      }
+    }
+    if (!found) {
+      // No step length helps: back to the iterate; a fresh factor is asked for below.
+      write_free(m_u, x);
+      norm = residual(net, x, v, dt);
+      if (potential_is_double) break;
+      // The iterate's potential was single precision (the predictor's): now it is double, so
+      // the step is tried again with Armijo's condition too.
+      potential_is_double = true;
+      continue;
+    }
+    norm = trial;
+    potential_is_double = true;
+    m_u.head(m) = m_u_next.head(m);
+  }
+  report.residual = norm;
+  report.converged = norm <= tolerance;
+  if (!report.converged || report.iterations > refresh_after_iterations) request_refresh(net, x, dt);
+  return report;
+}
+
+NewtonReport NewtonStepper::advance_static(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept {
+  NewtonReport report;
+  const int n = net.node_count;
+  m_x0.leftCols(n) = x.leftCols(n);
+  m_v0.leftCols(n) = v.leftCols(n);
   // `fresh`: the kept factorisation was computed at the current iterate.
   bool fresh = false;
-  if (implicit ? m_factor_dt != dt : m_factor_dt < 0.0) {
+  if (m_factor_dt < 0.0) {
     if (!refactor(net, x, dt)) {
       report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
       return report;
@@ -205,66 +516,20 @@ NewtonReport NewtonStepper::advance(const SpringNetwork& net, Eigen::Matrix3Xd& 
     fresh = true;
   }
   const double tolerance = m_tolerance_ratio * net.stiffness.edge * net.block.cell_size;
-  // Backward Euler's predictor residual only sets the first Newton step (an approximate one
-  // already: the kept factor, read in single precision), so its forces are evaluated in single
-  // precision; every residual that decides convergence or a line-search step is double.
-  double norm = residual(net, x, v, dt,
-                         implicit ? LatticeForces::ForcePrecision::single_precision : LatticeForces::ForcePrecision::double_precision);
-  if (m_mode == Mode::implicit_euler && norm <= tolerance) norm = residual(net, x, v, dt); // converged already: decide in double
-  if (m_mode == Mode::linearly_implicit_euler) {
-    // A kept factorisation that no longer approximates the Jacobian lets a mode grow from
-    // sample to sample (the step's error (I − A_kept⁻¹ A) e is amplified). Every
-    // `linearised_check_interval`-th call the residual after the step is evaluated too, and if
-    // the step reduced it by less than 4 x (modified Newton's criterion) the factorisation is
-    // refreshed at the next call's predictor.
-    if (m_refresh_pending && !fresh) {
-      if (!refactor(net, x, dt)) {
-        // A not positive definite at x*: no step this sample (the state stays at the predictor,
-        // reported unconverged), the refresh is tried again at the next.
-        for (int k = 0; k < m_free_count; ++k) {
-          const int e = m_free_entry[static_cast<std::size_t>(k)];
-          v.data()[e] = (x.data()[e] - m_x0.data()[e]) * (1.0 / dt);
-        }
-        report.residual = norm;
-        return report;
-      }
-      ++report.factorisations;
-    }
-    m_refresh_pending = false;
-    // x = x* − A⁻¹ r(x*), v = (x − xₙ)/h: one linear solve.
-    m_system.solve(m_r, m_dx);
-    for (int k = 0; k < m_free_count; ++k) {
-      const int e = m_free_entry[static_cast<std::size_t>(k)];
-      x.data()[e] -= m_dx[m_free_dof[static_cast<std::size_t>(k)]];
-    }
-    report.iterations = 1;
-    report.residual = norm;
-    if (++m_calls_since_check >= linearised_check_interval) {
-      m_calls_since_check = 0;
-      report.residual = residual(net, x, v, dt); // also sets v
-      m_refresh_pending = report.residual > tolerance && report.residual > 0.25 * norm;
-    } else {
-      for (int k = 0; k < m_free_count; ++k) {
-        const int e = m_free_entry[static_cast<std::size_t>(k)];
-        v.data()[e] = (x.data()[e] - m_x0.data()[e]) * (1.0 / dt);
-      }
-    }
-    report.converged = x.leftCols(n).allFinite();
-    return report;
-  }
+  double norm = residual(net, x, v, dt);
   double previous = INFINITY;
   int refreshes = 0;
+  // Refreshes of the kept factorisation within one call: where even a fresh one converges
+  // slowly, refreshing at every iteration only multiplies the cost.
+  constexpr int max_refreshes = 1;
   while (report.iterations < m_max_iterations && norm > tolerance) {
-    // The kept factorisation no longer converges fast: refresh it (at most `max_refreshes`
-    // times per call: where even a fresh one converges slowly, as through a snap-through of
-    // crushed cells, refreshing at every iteration only multiplies the cost).
     if (!fresh && norm > 0.25 * previous && refreshes < max_refreshes) {
       ++refreshes;
       if (!refactor(net, x, dt)) break;
       ++report.factorisations;
       fresh = true;
     }
-    m_system.solve(m_r, m_dx);
+    active().solve(m_r, m_dx);
     ++report.iterations;
     m_x_before.leftCols(n) = x.leftCols(n);
     // Backtracking: x ← x − α Δx with α = 1, 1/2, …, 1/32, the first that lowers the residual.

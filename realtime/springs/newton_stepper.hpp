@@ -1,13 +1,21 @@
 #pragma once
 // NewtonStepper: the network's implicit Euler step and its quasi-static equilibrium, both solved
-// by Newton's method on the free degrees of freedom with a sparse LDLᵀ factorisation that is
-// kept while it still converges (modified Newton) and refreshed when it does not, with a
-// backtracking line search on the residual so that a step far from the solution never diverges.
+// by Newton's method on the free degrees of freedom with a sparse Cholesky factorisation that is
+// kept across samples (modified Newton), with a line search so that a step far from the
+// solution never diverges. For implicit Euler (the servo's default for a blade) the factor is
+// refreshed off the servo thread (FactorRefresh) and kept exact across vertex splits by a
+// low-rank correction (SplitCorrection): `advance` does not factorise (docs/spring-network.md §2,
+// "The kept factor and its refresh"); the linearly implicit and quasi-static steps refactorise
+// on the calling thread.
 
+#include "realtime/springs/factor_refresh.hpp"
 #include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/network_system.hpp"
+#include "realtime/springs/split_correction.hpp"
 #include "realtime/springs/spring_network.hpp"
 
+#include <array>
+#include <memory>
 #include <vector>
 
 namespace kerf {
@@ -15,66 +23,89 @@ namespace kerf {
 /// What one `advance` did.
 struct NewtonReport {
   int iterations = 0;
-  int factorisations = 0;
+  int factorisations = 0; ///< numeric factorisations on the calling thread (the first, a quasi-static refresh, a rebuild)
+  int refreshes = 0;      ///< fresh factors adopted from the worker at the start of this call
   bool converged = false;
   double residual = 0.0; ///< final max-norm of the residual [N]
+};
+
+/// How implicit Euler takes up a factor computed off the servo thread.
+struct FactorRefreshPolicy {
+  /// Calls between starting a refresh and adopting its factor; at that call the stepper waits
+  /// for the worker if it has not finished, so that a run is the same whatever the machine's
+  /// load (a study, a test). Negative: adopt at the first call after the worker has finished,
+  /// never waiting (the live rig: not reproducible from run to run).
+  int delay = 16;
+  /// Anderson acceleration depth of the kept-factor iteration (0: plain modified Newton).
+  int anderson_depth = 4;
 };
 
 class NewtonStepper {
 public:
   /// Linearly implicit Euler: the residual after the step is checked on every 8th call.
   static constexpr int linearised_check_interval = 8;
-  /// Backward Euler and quasi-static: refreshes of the kept factorisation within one `advance`
-  /// (besides the one a new dt or a tear needs). Where even a fresh factorisation converges
-  /// slowly (a snap-through of the cells crushed under a blade, whose tangent is indefinite
-  /// while K_T is projected) refreshing at every iteration multiplied a sample's cost up to
-  /// 8 x (potato_rect_cut at 8³: 46 ms CPU, one refresh each: 8.5 ms) without converging.
-  static constexpr int max_refreshes = 1;
+  /// Backward Euler: a call that needed more kept-factor iterations than this (or did not
+  /// converge) asks for a fresh factor.
+  static constexpr int refresh_after_iterations = 2;
 
   enum class Mode {
     /// Backward Euler: M (x − xₙ − h vₙ)/h² = f(x, (x − xₙ)/h), v = (x − xₙ)/h.
     implicit_euler,
-    /// Static equilibrium f(x, 0) = 0 per call (inertia and damping left out), v = 0.
+    /// Static equilibrium f(x, 0) = 0 per call (inertia and damping left out), v = 0. Factorises
+    /// on the calling thread (for comparison with the reference, not for the servo).
     quasi_static,
     /// Linearly implicit (linearised backward) Euler, Baraff & Witkin, "Large steps in cloth
     /// simulation", SIGGRAPH 1998, §4: backward Euler's equation linearised at the predictor
     /// x* = xₙ + h vₙ and solved once, x = x* − A⁻¹ r(x*), v = (x − xₙ)/h, with A the kept
-    /// factorisation (refreshed when dt changes, after a tear, and at the next call's x* when a
-    /// check finds it stale: every `linearised_check_interval`-th call also evaluates the
-    /// residual after the step, and a step that reduced it by less than 4 x (modified Newton's
-    /// criterion) marks it so; with a stale A a mode grows from sample to sample). One force
-    /// evaluation and one pair of triangular solves per call (a second evaluation on check
-    /// calls); otherwise the residual after the step is not evaluated, and the report is
-    /// `converged` whenever the new state is finite (its `residual` is the predictor's, or after
-    /// the step on check calls). At the predictor the velocity is vₙ, so the inertia term of
-    /// the residual vanishes and r(x*) = −f(x*, vₙ): while the network is untorn the step takes
-    /// f in single precision straight from the lattice into the single-precision solve and back
+    /// factorisation (refactorised on the calling thread when dt changes, after a tear, and at
+    /// the next predictor when a check finds it stale: every `linearised_check_interval`-th call
+    /// also evaluates the residual after the step, and a step that reduced it by less than 4 x
+    /// (modified Newton's criterion) marks it so; with a stale A a mode grows from sample to
+    /// sample, and one solve per sample leaves no iteration to bridge it). One force evaluation
+    /// and one pair of triangular solves per call (a second evaluation on check calls);
+    /// otherwise the residual after the step is not evaluated, and the report is `converged`
+    /// whenever the new state is finite (its `residual` is the predictor's, or after the step
+    /// on check calls). At the predictor the velocity is vₙ, so the inertia term of the
+    /// residual vanishes and r(x*) = −f(x*, vₙ): while the network is untorn the step takes f in
+    /// single precision straight from the lattice into the single-precision solve and back
     /// (x ← x* + A⁻¹ f, v ← vₙ + A⁻¹ f / h), without the per-node force arrays; `forces()` then
     /// holds the forces of the last check call (after a tear: those at the predictor).
     linearly_implicit_euler
   };
 
-  /// Builds the system's pattern for `net` (allocates). `max_iterations` >= 1 per advance;
-  /// `relative_tolerance` ε > 0: converged when the residual's max-norm is <= ε k₁ h [N] (the
-  /// force of an edge spring stretched by ε of its length).
-  /// `tear_ready`: the system's pattern has room for vertex splits (NetworkSystem::rebuild), so
-  /// that `retopologise` can follow a tear without allocating.
+  /// Builds the system's pattern for `net` (allocates; for implicit Euler also starts the
+  /// refresh worker). `max_iterations` >= 1 per advance; `relative_tolerance` ε > 0: converged
+  /// when the residual's max-norm is <= ε k₁ h [N] (the force of an edge spring stretched by ε of
+  /// its length). `tear_ready`: the system's pattern has room for vertex splits
+  /// (NetworkSystem::rebuild), so that `retopologise` can follow a tear without allocating.
   NewtonStepper(const SpringNetwork& net, Mode mode, int max_iterations, double relative_tolerance = 1e-9,
-                bool tear_ready = false);
+                bool tear_ready = false, FactorRefreshPolicy policy = {});
 
-  /// Re-analyses after the network's cells, nodes or constraints changed (a tear). Allocates.
+  /// Re-analyses after the network's cells, nodes or constraints changed (a tear that did not fit
+  /// the pattern). Allocates; the next `advance` factorises.
   void rebuild(const SpringNetwork& net);
-  /// After vertex splits on a tear-ready stepper: binds the copies to the kept pattern and marks
-  /// the factorisation stale (the next `advance` refactorises). Allocation-free; false if the
-  /// splits do not fit (then call `rebuild`).
-  bool retopologise(const SpringNetwork& net) noexcept;
+  /// Factorises the matrix of a step of `dt` at positions x on the calling thread (the exact
+  /// tangent, or the projected one where that is not positive definite): the kept factor until
+  /// the first refresh. Call before the first `advance` (a model's reset) so that `advance` never
+  /// factorises; if not called, the first `advance` does it. Allocation-free.
+  bool prime(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
+  /// After vertex splits on a tear-ready stepper (x: the positions at the split): binds the
+  /// copies to the kept pattern and, for implicit Euler, corrects the kept factor for them
+  /// (SplitCorrection; the other modes refactorise at their next `advance`). Allocation-free;
+  /// false if the splits do not fit (then call `rebuild`).
+  bool retopologise(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept;
 
   /// Advances (x, v) by dt [s]. On entry the free axes hold the state at tₙ and the fixed axes
-  /// their prescribed end-of-step positions and velocities. The Jacobian A = M/h² + (1 + τ/h) K_T (implicit) or K_T + 10⁻⁸ (‖K‖/‖M‖) M (quasi-static; the
-  /// small mass term only regularises floating pieces and leaves the solution unchanged) is
-  /// factorised on the first call, when dt changes, and (at most `max_refreshes` times per
-  /// call) when an iteration reduces the residual by less than a factor 4, or when no step
-  /// length of the line search (1, 1/2, …, 1/32 of the Newton step) lowers the residual.
+  /// their prescribed end-of-step positions and velocities. The Jacobian A = M/h² + (1 + τ/h) K
+  /// (implicit) or K + 10⁻⁸ (‖K‖/‖M‖) M (quasi-static; the small mass term only regularises
+  /// floating pieces and leaves the solution unchanged), K the exact tangent where A is positive
+  /// definite with it, else the projected one (CellTangent). Implicit Euler iterates on the kept
+  /// factor (with the pending splits' correction), accelerated by Anderson mixing, each step
+  /// accepted when it lowers the residual's max-norm or satisfies Armijo's condition on the
+  /// step's incremental potential, backtracking (1/2, …, 1/32) otherwise; a call that needs
+  /// more than `refresh_after_iterations` iterations, does not converge, changes dt or follows a
+  /// split asks for a fresh factor, adopted as `FactorRefreshPolicy` says. Quasi-static
+  /// refactorises on the calling thread when an iteration reduces the residual by less than 4 x.
   /// Allocation-free.
   NewtonReport advance(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
 
@@ -82,29 +113,71 @@ public:
   /// zero velocity quasi-statically) [N], 3 x capacity: the residual's own evaluation, so the
   /// caller need not recompute them. Linearly implicit: the forces at the predictor x*.
   [[nodiscard]] const Eigen::Matrix3Xd& forces() const { return m_f; }
+  /// The tangent of the kept factor.
+  [[nodiscard]] CellTangent factor_tangent() const { return m_factor_tangent; }
 
 private:
+  NetworkSystem& active() { return *m_systems[static_cast<std::size_t>(m_active)]; }
+  /// Assembles and factorises the active system on the calling thread.
   bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
+  [[nodiscard]] double mass_weight(double dt) const;
+  [[nodiscard]] double stiffness_weight(const SpringNetwork& net, double dt) const;
+  /// Starts a refresh at positions x (if none is running).
+  void request_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
+  /// Adopts a finished refresh when the policy says so, corrected for the splits made since its
+  /// snapshot (x: the positions now); counts it in `report`.
+  void collect_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, NewtonReport& report) noexcept;
+  /// Corrects the kept factor for split number `index` (recorded by `retopologise`).
+  bool correct_for_split(const SpringNetwork& net, const Eigen::Matrix3Xd& x, long index) noexcept;
   double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
                   LatticeForces::ForcePrecision precision = LatticeForces::ForcePrecision::double_precision) noexcept;
-  /// The linearly implicit step while the network is untorn (see Mode::linearly_implicit_euler).
   NewtonReport advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+  NewtonReport advance_linearised(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+  NewtonReport advance_implicit(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+  NewtonReport advance_static(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
   /// The free entries (3 p + i with a dof) in node order, their dofs and node masses, from the
   /// system's numbering (after rebuild and after binding splits). Allocation-free.
   void bind_free_entries(const SpringNetwork& net) noexcept;
+  /// x's free entries from the iterate vector u (per free entry).
+  void write_free(const Eigen::VectorXd& u, Eigen::Matrix3Xd& x) const noexcept;
 
   Mode m_mode;
   int m_max_iterations;
-  NetworkSystem m_system;
+  FactorRefreshPolicy m_policy;
+  std::array<std::unique_ptr<NetworkSystem>, 2> m_systems; ///< the kept factor's and the refresh's
+  int m_active = 0;
+  std::unique_ptr<FactorRefresh> m_refresh; ///< the worker (implicit Euler)
+  SplitCorrection m_correction;
   LatticeForces m_forces;
   double m_tolerance_ratio;
   bool m_tear_ready = false;
+  // The kept factor: its dt (negative: none yet), tangent and weights.
   double m_factor_dt = -1.0;
+  CellTangent m_factor_tangent = CellTangent::projected;
+  double m_factor_mass_weight = 0.0, m_factor_stiffness_weight = 0.0;
+  // The running refresh: the call it started at, its dt and weights.
+  long m_calls = 0;
+  long m_job_call = 0;
+  double m_job_dt = 0.0;
+  double m_job_mass_weight = 0.0, m_job_stiffness_weight = 0.0;
+  long m_splits = 0; ///< vertex splits bound so far
+  bool m_uncorrected = false; ///< a split the kept factor could not be corrected for: refactorise
+  /// The last splits (by index modulo the ring's size): original, copy, the original's mass before.
+  struct RecordedSplit {
+    long index = -1;
+    int original = -1, copy = -1;
+    double mass_before = 0.0;
+  };
+  std::array<RecordedSplit, SplitCorrection::max_splits> m_recent{};
   double m_static_regularisation = 0.0;
   bool m_refresh_pending = false; ///< linearly implicit: the last check found the kept factorisation stale
   int m_calls_since_check = 0;    ///< linearly implicit: calls since the residual after the step was last checked
+  double m_potential = 0.0;       ///< the incremental potential at the last residual evaluation [J]
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
   Eigen::VectorXd m_r, m_dx;
+  // Anderson mixing, per free entry: the iterate, its step, the previous ones, their differences.
+  Eigen::VectorXd m_u, m_g, m_u_previous, m_g_previous, m_u_next;
+  Eigen::MatrixXd m_du, m_dg;
   int m_free_count = 0;
   std::vector<int> m_free_entry, m_free_dof; ///< per free entry: 3 p + i, and its dof
   std::vector<double> m_free_mass;           ///< per free entry: the node's mass [kg]

@@ -133,9 +133,14 @@ void merge_springs(SpringNetwork& net) noexcept {
 }
 
 Eigen::Matrix3d cell_deformation_gradient(const Eigen::Matrix<double, 3, 8>& corners, double h) {
-  // F = Σ_a x_a ⊗ g_a, g_a = s_a / (4h)
-  Eigen::Matrix3d F = Eigen::Matrix3d::Zero();
-  for (int a = 0; a < 8; ++a) F += corners.col(a) * (corner_sign(a) / (4.0 * h)).transpose();
+  // F = Σ_a x_a ⊗ g_a, g_a = s_a / (4h): column j is (Σ_{a: bit j of a set} x_a − Σ_{others} x_a) / (4h).
+  const Eigen::Vector3d x0 = corners.col(0), x1 = corners.col(1), x2 = corners.col(2), x3 = corners.col(3);
+  const Eigen::Vector3d x4 = corners.col(4), x5 = corners.col(5), x6 = corners.col(6), x7 = corners.col(7);
+  const double w = 0.25 / h;
+  Eigen::Matrix3d F;
+  F.col(0) = w * ((x1 - x0) + (x3 - x2) + (x5 - x4) + (x7 - x6));
+  F.col(1) = w * ((x2 - x0) + (x3 - x1) + (x6 - x4) + (x7 - x5));
+  F.col(2) = w * ((x4 - x0) + (x5 - x1) + (x6 - x2) + (x7 - x3));
   return F;
 }
 
@@ -190,8 +195,9 @@ double cell_forces(const SpringNetwork& net, int cell, const Eigen::Matrix<doubl
 }
 
 void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
-                           Eigen::Matrix<double, 24, 24>& K) noexcept {
+                           Eigen::Matrix<double, 24, 24>& K, CellTangent tangent) noexcept {
   (void)cell;
+  const bool exact = tangent == CellTangent::exact;
   K.setZero();
   for (const CellSpring& s : cell_springs) {
     const Eigen::Vector3d e = x.col(s.b) - x.col(s.a);
@@ -201,8 +207,9 @@ void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matr
     if (!(l > 1e-12 * L)) continue;
     const Eigen::Vector3d d = e / l;
     const Eigen::Matrix3d dd = d * d.transpose();
-    // K_aa = k [d dᵀ + max(0, 1 − L/l)(I − d dᵀ)]
-    const Eigen::Matrix3d Kaa = k * (dd + std::max(0.0, 1.0 - L / l) * (Eigen::Matrix3d::Identity() - dd));
+    // K_aa = k [d dᵀ + g (I − d dᵀ)],  g = 1 − L/l  (projected: max(0, g))
+    const double g = exact ? 1.0 - L / l : std::max(0.0, 1.0 - L / l);
+    const Eigen::Matrix3d Kaa = k * (dd + g * (Eigen::Matrix3d::Identity() - dd));
     K.block<3, 3>(3 * s.a, 3 * s.a) += Kaa;
     K.block<3, 3>(3 * s.b, 3 * s.b) += Kaa;
     K.block<3, 3>(3 * s.a, 3 * s.b) -= Kaa;
@@ -211,11 +218,25 @@ void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matr
   const double kappa = net.stiffness.volume_modulus;
   if (kappa > 0.0) {
     const double h = net.block.cell_size;
-    const Eigen::Matrix3d cof = cofactor(cell_deformation_gradient(x, h));
+    const double V0 = h * h * h;
+    const Eigen::Matrix3d F = cell_deformation_gradient(x, h);
+    const Eigen::Matrix3d cof = cofactor(F);
     Eigen::Matrix<double, 24, 1> dJ;
     for (int a = 0; a < 8; ++a) dJ.segment<3>(3 * a) = cof * (corner_sign(a) / (4.0 * h));
     // κ V₀ ∇J ∇Jᵀ
-    K.noalias() += kappa * h * h * h * dJ * dJ.transpose();
+    K.noalias() += kappa * V0 * dJ * dJ.transpose();
+    if (exact) {
+      // κ V₀ (J − 1) ∂²J/∂x_a∂x_b:  [i][k] = ε_ikm w_m,  w = F (g_a × g_b)
+      const double scale = kappa * V0 * (F.determinant() - 1.0);
+      for (int a = 0; a < 8; ++a)
+        for (int b = a + 1; b < 8; ++b) {
+          const Eigen::Vector3d w = scale * (F * (corner_sign(a) / (4.0 * h)).cross(corner_sign(b) / (4.0 * h)));
+          Eigen::Matrix3d H;
+          H << 0.0, w.z(), -w.y(), -w.z(), 0.0, w.x(), w.y(), -w.x(), 0.0;
+          K.block<3, 3>(3 * a, 3 * b) += H;
+          K.block<3, 3>(3 * b, 3 * a) += H.transpose(); // g_b × g_a = −(g_a × g_b); the diagonal blocks vanish
+        }
+    }
   }
 }
 

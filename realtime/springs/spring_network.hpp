@@ -114,12 +114,25 @@ Eigen::Matrix3d cell_deformation_gradient(const Eigen::Matrix<double, 3, 8>& cor
 double cell_forces(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
                    const Eigen::Matrix<double, 3, 8>& v, Eigen::Matrix<double, 3, 8>& f) noexcept;
 
-/// The cell's stiffness (24 x 24, corner-major) for Newton, kept positive semi-definite:
-///   spring block K_aa = k [d dᵀ + max(0, 1 − L/l)(I − d dᵀ)], K_ab = −K_aa;
-///   volume block κ V₀ (cof(F) g_a)(cof(F) g_b)ᵀ (the (J − 1) ∂²J term is left out).
-/// At rest it is the exact linear stiffness.
+/// Which stiffness `cell_stiffness_matrix` returns.
+enum class CellTangent {
+  /// Positive semi-definite: a compressed spring's negative geometric stiffness and the volume
+  /// term's (J − 1) ∂²J are left out.
+  projected,
+  /// The derivative of the elastic forces, −∂f/∂x (indefinite where springs buckle or cells
+  /// collapse).
+  exact
+};
+
+/// The cell's stiffness (24 x 24, corner-major) for Newton:
+///   spring block K_aa = k [d dᵀ + g (I − d dᵀ)], K_ab = −K_aa, with g = 1 − L/l (exact) or
+///   max(0, 1 − L/l) (projected);
+///   volume block κ V₀ [(cof(F) g_a)(cof(F) g_b)ᵀ + (J − 1) ∂²J/∂x_a∂x_b] (the second term only
+///   exact), where ∂²J/∂x_a,i∂x_b,k = ε_ikm w_m, w = F (g_a × g_b) (the second derivative of
+///   det F, ε_ikm ε_jln F_mn, contracted with g_a,j g_b,l).
+/// At rest both are the exact linear stiffness.
 void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matrix<double, 3, 8>& x,
-                           Eigen::Matrix<double, 24, 24>& K) noexcept;
+                           Eigen::Matrix<double, 24, 24>& K, CellTangent tangent = CellTangent::projected) noexcept;
 
 /// Sum of all cells' internal forces into f (3 x capacity, overwritten for nodes in use), the
 /// same forces as cell_forces summed over the cells but with the springs taken from the merged

@@ -81,6 +81,12 @@ struct SpringNetworkSetup {
   double grasp_radius = 0.0;
   std::vector<SpringSupport> supports;
   std::vector<SpringStylus> styluses; ///< one or two
+  /// Implicit Euler: how a factor refreshed off the servo thread is taken up (NewtonStepper; the
+  /// default adopts it a fixed number of samples after asking, so that a run is reproducible).
+  FactorRefreshPolicy refresh;
+  /// The sample period the implicit integrators' first factor is computed for [s] (at reset, off
+  /// the servo's path; another dt refreshes it). 1 ms: the servo's usual 1 kHz.
+  double expected_dt = 1e-3;
 };
 
 /// The model. Construction (allocates):
@@ -119,6 +125,11 @@ public:
   [[nodiscard]] std::string_view name() const override { return "springs"; }
   [[nodiscard]] int tool_count() const override { return static_cast<int>(m_setup.styluses.size()); }
   void reset() override;
+  /// The implicit integrators' refresh policy (SpringNetworkSetup::refresh); takes effect now (a reset).
+  void set_refresh_policy(FactorRefreshPolicy policy) {
+    m_setup.refresh = policy;
+    reset();
+  }
   void step(std::span<const ToolState> tools, double dt, std::span<ForceSample> forces) noexcept override;
 
   /// The network as it is now (cells re-pointed by tears) and its node positions [m].
@@ -129,8 +140,16 @@ public:
   [[nodiscard]] double stability_limit() const { return m_stability_limit; } ///< explicit h_crit [s]
   [[nodiscard]] int last_substeps() const { return m_last_substeps; }
   [[nodiscard]] int tears() const { return m_tears; }     ///< vertex splits so far
-  /// Numeric factorisations the implicit or quasi-static integrator made since reset().
+  /// Numeric factorisations made on the stepping thread in `step` since reset(): the linearly
+  /// implicit and quasi-static integrators' refreshes, and implicit Euler's rare fallbacks (a
+  /// split the pattern could not take, more splits pending than its correction holds); its
+  /// other factors are computed at reset and off the servo thread.
   [[nodiscard]] long factorisations() const { return m_factorisations; }
+  /// Fresh factors the implicit integrator adopted from its worker since reset().
+  [[nodiscard]] long refreshes() const { return m_refreshes; }
+  /// Samples since reset() that did not converge (or exceeded the explicit sub-step bound): the
+  /// samples reported over budget.
+  [[nodiscard]] long unconverged_samples() const { return m_unconverged; }
   [[nodiscard]] int pieces() const { return m_pieces; }   ///< connected pieces of the network
   [[nodiscard]] int attached_nodes(int stylus) const;
   /// A compliant grasp's anchored nodes of `stylus` and the sum of their stiffnesses Σ K_p [N/m].
@@ -139,6 +158,19 @@ public:
 
 private:
   void build(const TetMesh& mesh);
+  /// Step 4 of `build`: the nodes under each stylus attached to it (a compliant grasp: its
+  /// anchors), fixed, and the lists that follow from them (attached nodes, tool cells, nodes
+  /// never split).
+  void attach_to_styluses(SpringNetwork& net, const std::vector<Eigen::Vector3d>& contact,
+                          const std::vector<Eigen::Vector3d>& contact_normal, double h);
+  /// The steps of `step`: the attached nodes and anchors at fraction s of the sample; the
+  /// network advanced by dt under the explicit integrator's sub-steps or the Newton stepper
+  /// (each returns whether the sample is over budget); the force on each stylus; a tear.
+  void place_attached(std::span<const ToolState> tools, double s, double dt) noexcept;
+  bool advance_explicit(std::span<const ToolState> tools, double dt) noexcept;
+  bool advance_implicit(std::span<const ToolState> tools, double dt) noexcept;
+  void stylus_forces(std::span<ForceSample> forces, bool over_budget) noexcept;
+  void tear_overstressed(std::span<ForceSample> forces) noexcept;
 
   SpringNetworkSetup m_setup;
   CellIdentification m_identification;
@@ -162,6 +194,8 @@ private:
   int m_last_substeps = 0;
   int m_tears = 0;
   long m_factorisations = 0;
+  long m_refreshes = 0;
+  long m_unconverged = 0;
   int m_pieces = 1;
   LatticeForces m_lattice;               ///< the explicit integrator's force loops
   std::unique_ptr<NewtonStepper> m_newton;

@@ -72,7 +72,11 @@ bool VertexTearing::tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3
   for (int p = 0; p < n; ++p) {
     const int count = m_cells[static_cast<std::size_t>(p)];
     if (count < 2 || excluded[static_cast<std::size_t>(p)] || m_opened[static_cast<std::size_t>(p)]) continue;
-    eigen.computeDirect(m_stress[static_cast<std::size_t>(p)] / count);
+    const Eigen::Matrix3d sigma = m_stress[static_cast<std::size_t>(p)] / count;
+    // σ₁ ≤ |σ|_F: a vertex whose norm is within the largest σ₁ so far can neither raise it nor,
+    // above the limit, exceed the worst one (which is that largest σ₁ once one is found).
+    if (sigma.norm() <= m_last_max) continue;
+    eigen.computeDirect(sigma);
     const double s1 = eigen.eigenvalues()[2];
     m_last_max = std::max(m_last_max, s1);
     if (s1 > m_limit && s1 > worst_stress) {

@@ -101,6 +101,95 @@ void VoxelSurfaceCuttingModel::start_episode(const Eigen::Vector3d& centre, cons
   place_grid_around(frame.local(centre + m_setup.tool_radius * frame.depth_axis), false);
 }
 
+void VoxelSurfaceCuttingModel::keep_tip_inside_grid(const Eigen::Vector3d& tip) noexcept {
+  // Keep the tip well inside the grid: re-centre (keeping the overlap) near its border.
+  const int margin_lateral = std::max(1, std::min(m_grid.u_cells(), m_grid.v_cells()) / 4);
+  const int layer = m_grid.cell_index(tip.x()) - m_grid.layer_top();
+  int i = 0, j = 0;
+  const bool inside = m_grid.column_at(tip.y(), tip.z(), i, j);
+  const bool lateral_ok = inside && i >= margin_lateral && i < m_grid.u_cells() - margin_lateral &&
+                          j >= margin_lateral && j < m_grid.v_cells() - margin_lateral;
+  const bool depth_ok = layer >= 1 && layer <= m_grid.depth_cells() - 2;
+  if (!lateral_ok || (!depth_ok && m_grid.depth_cells() >= 3)) place_grid_around(tip, true);
+}
+
+bool VoxelSurfaceCuttingModel::press_surface_point(const Eigen::Vector3d& tip, int i, int j, const Eigen::Vector3d& velocity,
+                                                   double& normal_force) noexcept {
+  const VoxelCuttingSetup& s = m_setup;
+  bool advanced = false;
+  // Depth direction (§2.3 step 3): the tip below its column's surface point by δ_d.
+  double delta_d = tip.x() - m_grid.surface_depth(i, j);
+  if (delta_d > 0.0) {
+    m_last_depth_force = s.contact_stiffness * delta_d;
+    if (m_last_depth_force > s.critical_force_depth) { // advance the surface point
+      m_slack = std::max(m_slack, m_grid.lower(i, j, m_grid.surface_depth(i, j) + s.advance_length, m_vertices, m_original));
+      ++m_depth_advances;
+      advanced = true;
+      delta_d = tip.x() - m_grid.surface_depth(i, j);
+    }
+    // F_n = k_e δ_d + λ δ_d dδ_d/dt, never pulling the stick in. The damper acts per unit
+    // penetration, so F_n is continuous where the contact begins and ends: an advance that
+    // leaves the tip above the new surface point drops the elastic part (at most the critical
+    // force plus one sample's increment), and the damping with it only as far as δ_d falls.
+    if (delta_d > 0.0)
+      normal_force = std::max(0.0, delta_d * (s.contact_stiffness + s.damping * velocity.dot(m_frame.depth_axis)));
+  }
+  return advanced;
+}
+
+bool VoxelSurfaceCuttingModel::press_column_wall(const Eigen::Vector3d& tip, int i, int j, double& wall_force) noexcept {
+  const VoxelCuttingSetup& s = m_setup;
+  const double h = s.advance_length;
+  const double r = s.tool_radius;
+  const Eigen::Vector3d& c = m_cut_direction;
+  const double c_a = c.dot(m_frame.u_axis), c_b = c.dot(m_frame.v_axis);
+  // Cutting direction: the leading point of the stick inside a neighbouring column whose
+  // material reaches above the tip is pressed δ_c into that column's wall.
+  int i2 = 0, j2 = 0;
+  const double lead_a = tip.y() + r * c_a, lead_b = tip.z() + r * c_b;
+  if (!(m_have_cut_direction && m_grid.column_at(lead_a, lead_b, i2, j2) && (i2 != i || j2 != j) &&
+        m_grid.surface_depth(i2, j2) < tip.x()))
+    return false;
+  // δ_c: distance from the leading point back along -c to where it entered the column.
+  double delta_c = h;
+  if (c_a > 1e-12) delta_c = std::min(delta_c, (lead_a - m_grid.a_lower(i2)) / c_a);
+  if (c_a < -1e-12) delta_c = std::min(delta_c, (m_grid.a_lower(i2) + h - lead_a) / -c_a);
+  if (c_b > 1e-12) delta_c = std::min(delta_c, (lead_b - m_grid.b_lower(j2)) / c_b);
+  if (c_b < -1e-12) delta_c = std::min(delta_c, (m_grid.b_lower(j2) + h - lead_b) / -c_b);
+  delta_c = std::max(0.0, delta_c);
+  m_last_cutting_force = s.contact_stiffness * delta_c;
+  if (!(m_last_cutting_force > s.critical_force_cutting)) {
+    wall_force = m_last_cutting_force;
+    return false;
+  }
+  // The front advances one column.
+  m_slack = std::max(m_slack, m_grid.lower(i2, j2, tip.x(), m_vertices, m_original));
+  // A stick wider than a column (r > h: a knife's Cw, docs/models.md, voxel) also clears the
+  // columns between its tip and its leading point, which it sweeps on its way: each one
+  // whose material reaches above the tip, sampled every half column along c.
+  for (double along = 0.5 * h; along < r; along += 0.5 * h) {
+    int i3 = 0, j3 = 0;
+    if (m_grid.column_at(tip.y() + along * c_a, tip.z() + along * c_b, i3, j3) && (i3 != i || j3 != j) &&
+        (i3 != i2 || j3 != j2) && m_grid.surface_depth(i3, j3) < tip.x())
+      m_slack = std::max(m_slack, m_grid.lower(i3, j3, tip.x(), m_vertices, m_original));
+  }
+  if (m_episode_cut_advances++ == 0) m_cut_start = Eigen::Vector2d(tip.y(), tip.z());
+  ++m_total_cut_advances;
+  return true;
+}
+
+InteractionMode VoxelSurfaceCuttingModel::interaction_mode(bool contact, bool forward) const noexcept {
+  // Modes (docs/models.md, voxel): deformation-1 before the episode's first advance, cutting
+  // while the front keeps up with the moving tool, deformation-2 when pressing without cutting.
+  // The front advances once per advance length of travel in steady cutting; 1.5 advance
+  // lengths without one is no longer cutting.
+  InteractionMode mode = InteractionMode::no_contact;
+  if (m_episode_advances == 0) mode = contact ? InteractionMode::deformation_1 : InteractionMode::no_contact;
+  else if (forward && m_travel - m_travel_at_advance < 1.5 * m_setup.advance_length) mode = InteractionMode::cutting;
+  else if (contact) mode = InteractionMode::deformation_2;
+  return mode;
+}
+
 void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*dt*/, std::span<ForceSample> forces) noexcept {
   ForceSample& out = forces[0];
   out = ForceSample{};
@@ -126,23 +215,11 @@ void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*d
     return;
   }
 
-  const VoxelFrame& frame = m_frame;
-  const Eigen::Vector3d& e_d = frame.depth_axis;
-  const Eigen::Vector3d tip = frame.local(p + r * e_d); // (w, a, b) of the stick's tip point
+  const Eigen::Vector3d& e_d = m_frame.depth_axis;
+  const Eigen::Vector3d tip = m_frame.local(p + r * e_d); // (w, a, b) of the stick's tip point
   m_travel += (p - m_previous_position).norm();
   m_previous_position = p;
-
-  // Keep the tip well inside the grid: re-centre (keeping the overlap) near its border.
-  {
-    const int margin_lateral = std::max(1, std::min(m_grid.u_cells(), m_grid.v_cells()) / 4);
-    const int layer = m_grid.cell_index(tip.x()) - m_grid.layer_top();
-    int i = 0, j = 0;
-    const bool inside = m_grid.column_at(tip.y(), tip.z(), i, j);
-    const bool lateral_ok = inside && i >= margin_lateral && i < m_grid.u_cells() - margin_lateral &&
-                            j >= margin_lateral && j < m_grid.v_cells() - margin_lateral;
-    const bool depth_ok = layer >= 1 && layer <= m_grid.depth_cells() - 2;
-    if (!lateral_ok || (!depth_ok && m_grid.depth_cells() >= 3)) place_grid_around(tip, true);
-  }
+  keep_tip_inside_grid(tip);
   out.over_budget = m_grid_incomplete;
 
   // Tangential velocity, the cutting direction, and the regularised direction of resistances.
@@ -153,59 +230,14 @@ void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*d
     m_have_cut_direction = true;
   }
   const Eigen::Vector3d resist = -v_t / std::sqrt(speed_t * speed_t + s.regularisation_speed * s.regularisation_speed);
-  const Eigen::Vector3d& c = m_cut_direction;
-  const double c_a = c.dot(frame.u_axis), c_b = c.dot(frame.v_axis);
 
   bool advanced = false;
   double normal_force = 0.0;
   double wall_force = 0.0;
   int i = 0, j = 0;
   if (m_grid.column_at(tip.y(), tip.z(), i, j)) {
-    // Depth direction (§2.3 step 3): the tip below its column's surface point by δ_d.
-    double delta_d = tip.x() - m_grid.surface_depth(i, j);
-    if (delta_d > 0.0) {
-      m_last_depth_force = s.contact_stiffness * delta_d;
-      if (m_last_depth_force > s.critical_force_depth) { // advance the surface point
-        m_slack = std::max(m_slack, m_grid.lower(i, j, m_grid.surface_depth(i, j) + h, m_vertices, m_original));
-        ++m_depth_advances;
-        advanced = true;
-        delta_d = tip.x() - m_grid.surface_depth(i, j);
-      }
-      // F_n = k_e δ_d + b dδ_d/dt, never pulling the stick in.
-      if (delta_d > 0.0) normal_force = std::max(0.0, s.contact_stiffness * delta_d + s.damping * velocity.dot(e_d));
-    }
-    // Cutting direction: the leading point of the stick inside a neighbouring column whose
-    // material reaches above the tip is pressed δ_c into that column's wall.
-    int i2 = 0, j2 = 0;
-    const double lead_a = tip.y() + r * c_a, lead_b = tip.z() + r * c_b;
-    if (m_have_cut_direction && m_grid.column_at(lead_a, lead_b, i2, j2) && (i2 != i || j2 != j) &&
-        m_grid.surface_depth(i2, j2) < tip.x()) {
-      // δ_c: distance from the leading point back along -c to where it entered the column.
-      double delta_c = h;
-      if (c_a > 1e-12) delta_c = std::min(delta_c, (lead_a - m_grid.a_lower(i2)) / c_a);
-      if (c_a < -1e-12) delta_c = std::min(delta_c, (m_grid.a_lower(i2) + h - lead_a) / -c_a);
-      if (c_b > 1e-12) delta_c = std::min(delta_c, (lead_b - m_grid.b_lower(j2)) / c_b);
-      if (c_b < -1e-12) delta_c = std::min(delta_c, (m_grid.b_lower(j2) + h - lead_b) / -c_b);
-      delta_c = std::max(0.0, delta_c);
-      m_last_cutting_force = s.contact_stiffness * delta_c;
-      if (m_last_cutting_force > s.critical_force_cutting) { // the front advances one column
-        m_slack = std::max(m_slack, m_grid.lower(i2, j2, tip.x(), m_vertices, m_original));
-        // A stick wider than a column (r > h: a knife's Cw, docs/models.md, voxel) also clears the
-        // columns between its tip and its leading point, which it sweeps on its way: each one
-        // whose material reaches above the tip, sampled every half column along c.
-        for (double along = 0.5 * h; along < r; along += 0.5 * h) {
-          int i3 = 0, j3 = 0;
-          if (m_grid.column_at(tip.y() + along * c_a, tip.z() + along * c_b, i3, j3) && (i3 != i || j3 != j) &&
-              (i3 != i2 || j3 != j2) && m_grid.surface_depth(i3, j3) < tip.x())
-            m_slack = std::max(m_slack, m_grid.lower(i3, j3, tip.x(), m_vertices, m_original));
-        }
-        if (m_episode_cut_advances++ == 0) m_cut_start = Eigen::Vector2d(tip.y(), tip.z());
-        ++m_total_cut_advances;
-        advanced = true;
-      } else {
-        wall_force = m_last_cutting_force;
-      }
-    }
+    advanced = press_surface_point(tip, i, j, velocity, normal_force);
+    if (press_column_wall(tip, i, j, wall_force)) advanced = true;
   }
   if (advanced) {
     ++m_episode_advances;
@@ -215,19 +247,13 @@ void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*d
   // (one advance length long then) to the tip now.
   if (m_episode_cut_advances > 0) m_cut_length = (Eigen::Vector2d(tip.y(), tip.z()) - m_cut_start).norm() + h;
 
-  // Modes (docs/models.md, voxel): deformation-1 before the episode's first advance, cutting
-  // while the front keeps up with the moving tool, deformation-2 when pressing without cutting.
-  // Moving forward: deeper, or along the surface. The front advances once per advance length
-  // of travel in steady cutting; 1.5 advance lengths without one is no longer cutting.
+  // Moving forward: deeper, or along the surface.
   const bool contact = normal_force > 0.0 || wall_force > 0.0;
   const bool forward = velocity.dot(e_d) > s.regularisation_speed || speed_t > s.regularisation_speed;
-  InteractionMode mode = InteractionMode::no_contact;
-  if (m_episode_advances == 0) mode = contact ? InteractionMode::deformation_1 : InteractionMode::no_contact;
-  else if (forward && m_travel - m_travel_at_advance < 1.5 * h) mode = InteractionMode::cutting;
-  else if (contact) mode = InteractionMode::deformation_2;
+  const InteractionMode mode = interaction_mode(contact, forward);
 
   m_last_depth = tip.x();
-  Eigen::Vector3d force = -normal_force * e_d - wall_force * c;
+  Eigen::Vector3d force = -normal_force * e_d - wall_force * m_cut_direction;
   if (s.friction) force += s.friction_coefficient * normal_force * resist; // Coulomb, regularised
   if (mode == InteractionMode::cutting) {
     // §2.4: the buried edge's resistances, against the tangential motion.

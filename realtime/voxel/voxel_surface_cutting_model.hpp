@@ -22,7 +22,9 @@ namespace kerf {
 struct VoxelCuttingSetup {
   double tool_radius = 0.0;            ///< cutting-stick tip radius r [m] > 0 (also Cw of Eq. 1)
   double contact_stiffness = 0.0;      ///< elastic coefficient k_e [N/m] > 0, also E of the DCS
-  double damping = 0.0;                ///< damping coefficient b on the penetration rate [N s/m] >= 0
+  /// Damping coefficient λ of the contact, per unit penetration [N s/m²] >= 0 (Table 1's unit):
+  /// the normal force's viscous part λ δ_d dδ_d/dt (Hunt & Crossley), zero at zero penetration.
+  double damping = 0.0;
   double friction_coefficient = 0.0;   ///< μ >= 0: Coulomb friction on the surface and M of Eq. 1
   double critical_force_depth = 0.0;   ///< depth-direction critical force [N] > 0 (Table 1)
   double critical_force_cutting = 0.0; ///< cutting-direction critical force [N] > 0 (Table 1)
@@ -51,8 +53,11 @@ struct VoxelCuttingSetup {
 ///   points cast from the polygon; it is re-centred (overlap kept) when the tip nears its border,
 ///   and released when the stick leaves the body (centre farther than r + 2 cells outside);
 /// - depth direction: the tip point (centre + r depth axis) below its column's surface point by
-///   δ_d feels F_n = k_e δ_d + b dδ_d/dt (>= 0) out of the body; when k_e δ_d exceeds the depth
-///   critical force the surface point advances by one advance length (§2.3 step 3);
+///   δ_d feels F_n = k_e δ_d + λ δ_d dδ_d/dt (>= 0) out of the body (a spring and, as Table 1's
+///   N s/m² says, a damper per unit penetration: Hunt & Crossley, "Coefficient of restitution
+///   interpreted as damping in vibroimpact", J. Appl. Mech. 42(2), 1975, with exponent 1 — a
+///   normal force that is continuous where the contact begins and ends); when k_e δ_d exceeds
+///   the depth critical force the surface point advances by one advance length (§2.3 step 3);
 /// - cutting direction c (the direction of the tangential velocity, once the tool has moved
 ///   along the surface in the episode; the last one while it stands): the stick's leading point
 ///   (centre + r c) inside a neighbouring column whose surface point lies above the tip is
@@ -110,6 +115,15 @@ public:
 private:
   void start_episode(const Eigen::Vector3d& centre, const SurfaceQuery::Closest& contact) noexcept;
   void place_grid_around(const Eigen::Vector3d& tip_local, bool keep_overlap) noexcept;
+  /// The steps of `step` (paper 002 §2.3): the grid re-centred near its border; the depth
+  /// direction's surface point pressed and advanced (F_n into normal_force); the cutting
+  /// direction's column wall pressed and the front advanced (the wall's force into wall_force);
+  /// each returns whether it advanced. The sample's interaction mode.
+  void keep_tip_inside_grid(const Eigen::Vector3d& tip) noexcept;
+  bool press_surface_point(const Eigen::Vector3d& tip, int i, int j, const Eigen::Vector3d& velocity,
+                           double& normal_force) noexcept;
+  bool press_column_wall(const Eigen::Vector3d& tip, int i, int j, double& wall_force) noexcept;
+  [[nodiscard]] InteractionMode interaction_mode(bool contact, bool forward) const noexcept;
 
   VoxelCuttingSetup m_setup;
   SurfaceQuery m_query;             ///< the body as built: first contact, leaving the body

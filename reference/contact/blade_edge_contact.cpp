@@ -34,15 +34,24 @@ std::vector<std::pair<Eigen::Vector3d, double>> blade_edge_points(const RigidToo
 BladeEdgeContact blade_edge_contact(const RigidToolShape& tool, const Eigen::Vector3d& position,
                                     std::span<const BoundaryFacet> facets,
                                     std::span<const Eigen::Vector3d> reference_positions,
-                                    std::span<const double> displacement, const BladeEdgeContactSettings& settings) {
+                                    std::span<const double> displacement, const BladeEdgeContactSettings& settings,
+                                    std::size_t part, std::size_t parts) {
   if (!(settings.line_penalty > 0.0) || !(settings.search_distance > 0.0))
     throw std::invalid_argument("blade edge contact: line_penalty and search_distance must be positive");
+  if (parts == 0 || part >= parts)
+    throw std::invalid_argument("blade edge contact: part " + std::to_string(part) + " of " + std::to_string(parts));
   if (displacement.size() != 3 * reference_positions.size())
     throw std::invalid_argument("blade edge contact: " + std::to_string(displacement.size()) +
                                 " displacement entries for " + std::to_string(reference_positions.size()) + " nodes");
-  const auto points = blade_edge_points(tool, position, settings.point_spacing);
+  auto points = blade_edge_points(tool, position, settings.point_spacing);
+  if (parts > 1) { // this part's share, k in [n part / parts, n (part + 1) / parts)
+    const std::size_t n = points.size();
+    points = std::vector<std::pair<Eigen::Vector3d, double>>(points.begin() + static_cast<std::ptrdiff_t>(n * part / parts),
+                                                             points.begin() + static_cast<std::ptrdiff_t>(n * (part + 1) / parts));
+  }
   BladeEdgeContact out;
   out.sampled_points = static_cast<int>(points.size());
+  if (points.empty()) return out;
   const auto node_count = static_cast<int>(reference_positions.size());
   auto x_of = [&](int k) {
     if (k < 0 || k >= node_count)

@@ -69,9 +69,13 @@ std::vector<std::pair<Eigen::Vector3d, double>> blade_edge_points(const RigidToo
 /// smallest distance to it — so a point under a concave fold (two facets tied on their shared
 /// edge) is inside, a point beside a convex ridge is not. Throws std::invalid_argument on bad
 /// settings or a facet node out of range.
+/// `part` of `parts`: only the edge points of that share of the edge (of the n points, those from
+/// ⌊n part / parts⌋ to ⌊n (part + 1) / parts⌋ − 1, in edge order), e.g. one MPI process's; the
+/// terms of the parts, concatenated in part order, are those of the whole edge in the same order.
 BladeEdgeContact blade_edge_contact(const RigidToolShape& tool, const Eigen::Vector3d& position,
                                     std::span<const BoundaryFacet> facets,
                                     std::span<const Eigen::Vector3d> reference_positions,
-                                    std::span<const double> displacement, const BladeEdgeContactSettings& settings);
+                                    std::span<const double> displacement, const BladeEdgeContactSettings& settings,
+                                    std::size_t part = 0, std::size_t parts = 1);
 
 } // namespace kerf::reference

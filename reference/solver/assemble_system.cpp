@@ -17,6 +17,7 @@
 #include <deal.II/lac/full_matrix.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -45,25 +46,42 @@ void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::Vec
     la.K = 0.0;
     *rhs = 0.0;
   }
+  // The assembly's time without the communication inside it (SolverTimings), also when it throws.
+  struct AssemblyTimer {
+    const Impl& m;
+    const std::chrono::steady_clock::time_point begin = std::chrono::steady_clock::now();
+    const double communication_before = communication();
+    double communication() const { return m.timings.communication_seconds + (m.parallel ? m.parallel->exchange_seconds : 0.0); }
+    ~AssemblyTimer() {
+      m.timings.assembly_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count() -
+                                    (communication() - communication_before);
+    }
+  } timer{*this};
+  // The state with the ghost values this process's cells, edge terms and cohesive pairs read.
+  const dealii::Vector<double>& state = la.readable(owned_state);
   // An element that fails on one process fails the assembly on every process (after the
   // collective compress), so that all of them take the same branch of Newton and line search.
   std::string failure;
   try {
-    assemble_cells(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_int, f_ext);
+    assemble_cells(state, load, with_matrix, out, constraints, la.K, rhs, f_int, f_ext);
   } catch (const FiniteStrainError& e) {
     failure = e.what();
   }
   out.edge_points = 0;
   out.edge_length = 0.0;
   out.max_line_load = 0.0;
-  if (blade_edge) assemble_blade_edge(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_ext);
-  assemble_foundations(la.ghosted(owned_state), load, with_matrix, out, constraints, la.K, rhs, f_ext);
-  if (with_matrix) {
-    la.K.compress(dealii::VectorOperation::add);
-    rhs->compress(dealii::VectorOperation::add);
+  if (blade_edge) assemble_blade_edge(state, load, with_matrix, out, constraints, la.K, rhs, f_ext);
+  assemble_foundations(state, load, with_matrix, out, constraints, la.K, rhs, f_ext);
+  if (distributed) {
+    // The entries added to other processes' rows and vectors go to their owners.
+    const ScopedTimer exchange(timings.communication_seconds);
+    if (with_matrix) {
+      la.K.compress(dealii::VectorOperation::add);
+      rhs->compress(dealii::VectorOperation::add);
+    }
+    f_int.compress(dealii::VectorOperation::add);
+    f_ext.compress(dealii::VectorOperation::add);
   }
-  f_int.compress(dealii::VectorOperation::add);
-  f_ext.compress(dealii::VectorOperation::add);
   if (max(failure.empty() ? 0.0 : 1.0) > 0.0)
     throw FiniteStrainError(failure.empty() ? "finite strain: an element of another process failed" : failure);
   // The contact and traction tallies of every process's cells.
@@ -92,7 +110,7 @@ void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::Vec
 }
 
 template <class VectorType, class MatrixType, class Tally>
-void FiniteStrainSolver::Impl::assemble_cells(const VectorType& state, const LoadState& load, bool with_matrix,
+void FiniteStrainSolver::Impl::assemble_cells(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
                                               Tally& out, const dealii::AffineConstraints<double>* constraints,
                                               MatrixType& K, VectorType* rhs, VectorType& f_int,
                                               VectorType& f_ext) const {

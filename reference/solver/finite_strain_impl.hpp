@@ -149,12 +149,28 @@ struct FiniteStrainSolver::Impl {
   }
   /// Sums over the processes (in place) when distributed.
   void sum(std::span<double> values) const {
-    if (distributed && !values.empty())
+    if (distributed && !values.empty()) {
+      const ScopedTimer timer(timings.communication_seconds);
       dealii::Utilities::MPI::sum(dealii::ArrayView<const double>(values.data(), values.size()), parallel->comm,
                                   dealii::ArrayView<double>(values.data(), values.size()));
+    }
   }
-  double sum(double value) const { return distributed ? dealii::Utilities::MPI::sum(value, parallel->comm) : value; }
-  double max(double value) const { return distributed ? dealii::Utilities::MPI::max(value, parallel->comm) : value; }
+  double sum(double value) const {
+    if (!distributed) return value;
+    const ScopedTimer timer(timings.communication_seconds);
+    return dealii::Utilities::MPI::sum(value, parallel->comm);
+  }
+  double max(double value) const {
+    if (!distributed) return value;
+    const ScopedTimer timer(timings.communication_seconds);
+    return dealii::Utilities::MPI::max(value, parallel->comm);
+  }
+  double min(double value) const { return -max(-value); }
+  /// All DOF values of the distributed vector `v` on every process (collective).
+  [[nodiscard]] dealii::Vector<double> gathered(const dealii::PETScWrappers::MPI::Vector& v) const;
+  // Where the solves' time went (SolverTimings): the assembly without the communication inside
+  // it, and the communication outside the ghost exchange (DistributedAlgebra::exchange_seconds).
+  mutable SolverTimings timings;
   /// |r| over the free DOFs (the Dirichlet entries masked out).
   template <class VectorType> double free_norm(const VectorType& r, const VectorType& mask) const {
     VectorType copy = r;
@@ -168,9 +184,10 @@ struct FiniteStrainSolver::Impl {
 
   // Blade edge pass (contact/blade_edge_contact.hpp), the second contact pass of a wedge tool: the
   // boundary facets of the whole body as flat triangles on compact node numbers (a P2 face split
-  // into four at its edge midpoints). Every process holds all of them and evaluates the same
-  // contact; each assembles only the terms on the facets of its own cells, and supplies the
-  // displacements of the nodes it is the first process to hold.
+  // into four at its edge midpoints). Every process holds all of them and supplies the
+  // displacements of the nodes it is the first process to hold; each searches its share of the
+  // edge points against all the facets, the terms found are shared, and each process assembles
+  // those on the facets of its own cells.
   struct BladeEdgeBoundary {
     std::vector<BoundaryFacet> facets;                     // compact node numbers, outward
     std::vector<char> facet_here;                          // this process assembles its terms
@@ -187,6 +204,7 @@ struct FiniteStrainSolver::Impl {
   // + face's quadrature points (the reference configuration does not change), and one history per
   // quadrature point.
   struct CohesivePair {
+    std::size_t index = 0; // the pair's place among the whole interface's pairs (build_cohesive)
     std::vector<dealii::types::global_dof_index> dofs; // the + cell's n DOFs, then the − cell's n
     std::vector<std::vector<double>> plus_values;      // [q][i]: N_i of the + cell (component comp[i])
     std::vector<std::vector<double>> minus_values;     // [q][j]: N_j of the − cell
@@ -195,8 +213,13 @@ struct FiniteStrainSolver::Impl {
     std::array<Eigen::Vector3d, 3> vertices;           // the face's reference vertices
     Eigen::Vector3d normal;                            // n, from − into + (reference)
   };
+  // Distributed, each process keeps the pairs whose + cell it owns (the interface elements are
+  // owned with the cells that carry them); the − cell may be another process's, and the DOFs of
+  // these pairs join the ghost values this process imports (DistributedAlgebra::relevant).
   std::optional<CohesiveLawParameters> cohesive_law;
-  std::vector<CohesivePair> cohesive_pairs;
+  std::vector<CohesivePair> cohesive_pairs; // this process's pairs, in the order of `index`
+  std::size_t cohesive_pair_total = 0;      // the pairs of the whole interface (all processes)
+  std::vector<dealii::types::global_dof_index> cohesive_dofs; // the DOFs of this process's pairs, sorted
   // The faces of the crack path, by active cell index × 4 + face: the unit direction into each
   // face's own material (+n on the + side, −n on the − side), which the wedge contact needs
   // (rigid_tool.hpp, tool_contact's `side`).
@@ -206,22 +229,23 @@ struct FiniteStrainSolver::Impl {
     const auto it = crack_face_sides.find(4 * cell->active_cell_index() + f);
     return it == crack_face_sides.end() ? Eigen::Vector3d::Zero() : it->second;
   }
-  std::vector<CohesiveState> cohesive_states; // pair-major, then quadrature point
+  std::vector<CohesiveState> cohesive_states; // this process's pairs, pair-major, then quadrature point
   std::vector<unsigned> cell_components;      // component of each local DOF of a cell
-  double cohesive_viscous_dissipation = 0.0;
-  double cohesive_trapezoid_work = 0.0; // dynamic step only: CohesiveSummary::trapezoid_work
+  double cohesive_viscous_dissipation = 0.0; // of the whole interface (summed over the processes)
+  double cohesive_trapezoid_work = 0.0; // dynamic step only: CohesiveSummary::trapezoid_work (whole interface)
 
   // ---- The dynamic step (newmark_dynamics.cpp) ------------------------------------------------------
-  // Dynamic step (SolverSettings::dynamic; serial only): Newmark average acceleration with the
+  // Dynamic step (SolverSettings::dynamic): Newmark average acceleration with the
   // consistent mass. Each cell's scalar mass matrix m_ij = ∫ ρ N_i N_j dV over its scalar shape
-  // functions (nodes × nodes, the same for the three components) is computed once in build. The
-  // committed state is u_n, v_n, a_n at `committed_time`; `step` is h of the solve under way
-  // (0: quasi-static, no inertia).
+  // functions (nodes × nodes, the same for the three components) is computed once in build (for
+  // this process's cells). The committed state is u_n, v_n, a_n at `committed_time`, all DOFs on
+  // every process (distributed: gathered when a step is committed); `step` is h of the solve under
+  // way (0: quasi-static, no inertia).
   struct Dynamics {
     std::vector<std::vector<double>> cell_mass; // by active cell index: nodes × nodes, row-major
     std::vector<unsigned> node_of_dof;          // a cell's local DOF -> its scalar node (0 .. nodes-1)
     unsigned nodes = 0;                         // scalar nodes per cell
-    dealii::Vector<double> u, v, a;             // u_n, v_n, a_n (all DOFs, global order)
+    dealii::Vector<double> u, v, a;             // u_n, v_n, a_n (all DOFs, global order, every process)
     double step = 0.0;                          // h [s] of the current solve
     double kinetic_energy = 0.0;                // ½ v_nᵀ M v_n [J]
     // Kelvin–Voigt damping (some region's retardation time > 0): the viscous nodal forces
@@ -262,7 +286,27 @@ struct FiniteStrainSolver::Impl {
   };
 
   // ---- system_setup.cpp ---------------------------------------------------------------------------
+  /// The discrete problem, in build's order (step-44's make_grid, system_setup, make_constraints):
+  /// the materials and the triangulation, its boundary ids, refined and distributed; the finite
+  /// element, the DoFs and the cells' geometry; the support points; the Dirichlet DoFs; the loads
+  /// (tractions, foundations, the tool); the dynamic step and the cohesive interface; the sparsity,
+  /// the vectors and the linear solver.
   void build(const FiniteStrainProblem& problem);
+  /// The material laws of the problem's regions; per tet, the index of the first region holding it.
+  std::vector<int> make_materials(const FiniteStrainProblem& problem);
+  void make_grid(const TetMesh& mesh, const std::vector<int>& material);
+  /// boundary_id = the face's class (its set of surface groups, `face_classes`).
+  void set_boundary_ids(const TetMesh& mesh);
+  void distribute_grid();
+  void setup_finite_element();
+  /// Each DoF's support point (node-major: DoF 3k + c at node k); fills reference_coordinate.
+  std::vector<dealii::Point<3>> support_points();
+  void make_dirichlet_dofs(const FiniteStrainProblem& problem, const std::vector<dealii::Point<3>>& support);
+  void setup_loads(const FiniteStrainProblem& problem);
+  void setup_serial_system(std::vector<dealii::Point<3>> support);
+  void setup_distributed_system(const std::vector<dealii::Point<3>>& support);
+  /// The index of the mesh's surface group `name`; throws naming `what` (support, traction, …).
+  [[nodiscard]] int surface_group(const std::string& name, const char* what) const;
   void build_cell_geometry();
   /// The Dirichlet constraints of the state `u`: the remaining increment target − u on every
   /// Dirichlet DOF (added to `c`, which is closed). Returns the largest |target − u| (all processes).
@@ -277,7 +321,7 @@ struct FiniteStrainSolver::Impl {
                 typename Algebra::VectorType* rhs);
   /// The cell loop of `assemble`: this process's cells into K, rhs, f_int, f_ext and the tallies.
   template <class VectorType, class MatrixType, class Tally>
-  void assemble_cells(const VectorType& state, const LoadState& load, bool with_matrix, Tally& out,
+  void assemble_cells(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix, Tally& out,
                       const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
                       VectorType& f_int, VectorType& f_ext) const;
 
@@ -286,6 +330,10 @@ struct FiniteStrainSolver::Impl {
   /// set back to `start`, the last converged state.
   template <class Algebra>
   EquilibriumReport newton(Algebra& la, const LoadState& load, const typename Algebra::VectorType& start);
+  /// One load's iteration: its state (the assemblies, the step, the quasi-Newton updates, the
+  /// interface tangent's choice), its steps (assemble, solve the linear system, line search,
+  /// accept the step) and, converged, the reactions and the commit.
+  template <class Algebra> class NewtonIteration;
 
   // ---- newmark_dynamics.cpp -----------------------------------------------------------------------
   void build_dynamics();
@@ -303,14 +351,16 @@ struct FiniteStrainSolver::Impl {
   /// viscous forces at (u_{n+1}, v_{n+1}) and the step's dissipation; returns ½ vᵀ M v.
   double commit_dynamics(const dealii::Vector<double>& u);
   /// The Kelvin–Voigt nodal forces f_v,a = ∫ P_v(F, Ḟ) : (e_c ⊗ Grad N_a) dV at displacement u and
-  /// velocity v (all DOFs, serial).
+  /// velocity v (all DOFs; this process's cells' terms).
   void assemble_viscous_force(const dealii::Vector<double>& u, const dealii::Vector<double>& v,
                               dealii::Vector<double>& out) const;
 
   // ---- blade_edge_pass.cpp ------------------------------------------------------------------------
   void build_blade_edge();
+  /// Distributed: every process's edge contact terms, in rank order (collective).
+  [[nodiscard]] std::vector<EdgeContactTerm> all_terms(const std::vector<EdgeContactTerm>& mine) const;
   template <class VectorType, class MatrixType, class Tally>
-  void assemble_blade_edge(const VectorType& state, const LoadState& load, bool with_matrix, Tally& out,
+  void assemble_blade_edge(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix, Tally& out,
                            const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
                            VectorType& f_ext) const;
 
@@ -321,7 +371,7 @@ struct FiniteStrainSolver::Impl {
   /// The foundations' traction k (d − u) on this process's faces into f_ext (and rhs), k ∫ N_a N_b dA
   /// into K, their force on the body and energy into `out` (this process's share).
   template <class VectorType, class MatrixType, class Tally>
-  void assemble_foundations(const VectorType& state, const LoadState& load, bool with_matrix, Tally& out,
+  void assemble_foundations(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix, Tally& out,
                             const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
                             VectorType& f_ext) const;
 
@@ -330,10 +380,17 @@ struct FiniteStrainSolver::Impl {
   template <class VectorType>
   Eigen::Vector3d cohesive_opening(const CohesivePair& pair, std::size_t q, const VectorType& state) const;
   template <class VectorType, class MatrixType>
-  void assemble_cohesive(const VectorType& state, const LoadState& load, bool with_matrix,
+  void assemble_cohesive(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
                          const dealii::AffineConstraints<double>* constraints, MatrixType& K, VectorType* rhs,
                          VectorType& f_int) const;
-  CohesiveSummary commit_cohesive(const LoadState& load);
+  /// Commits every point's history at the converged `state` (algebra.hpp's readable(): this
+  /// process's pairs' DOFs) and returns the whole interface's summary (summed over the processes).
+  CohesiveSummary commit_cohesive(const LoadState& load, const dealii::Vector<double>& state);
+  /// Distributed: the pairs whose + cell this process owns, numbered as the serial build numbers them.
+  void build_distributed_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group);
+  /// Distributed: the Dirichlet DOFs among la.relevant as the whole mesh assigns them (each process
+  /// sees only the supports of its own and ghost cells; a cohesive pair's − cell may be neither).
+  void complete_distributed_dirichlet();
 
   // ---- finite_strain_solver.cpp: the load-step driver ---------------------------------------------
   template <class Algebra> EquilibriumReport solve(Algebra& la, const LoadState& load);

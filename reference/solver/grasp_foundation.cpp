@@ -37,7 +37,7 @@ void FiniteStrainSolver::Impl::build_foundations(const FiniteStrainProblem& prob
 }
 
 template <class VectorType, class MatrixType, class Tally>
-void FiniteStrainSolver::Impl::assemble_foundations(const VectorType& state, const LoadState& load, bool with_matrix,
+void FiniteStrainSolver::Impl::assemble_foundations(const dealii::Vector<double>& state, const LoadState& load, bool with_matrix,
                                                     Tally& out, const dealii::AffineConstraints<double>* constraints,
                                                     MatrixType& K, VectorType* rhs, VectorType& f_ext) const {
   out.foundation_on_body.assign(foundations.size(), Eigen::Vector3d::Zero());
@@ -98,12 +98,12 @@ void FiniteStrainSolver::Impl::assemble_foundations(const VectorType& state, con
 }
 
 // For the two algebras (algebra.hpp); the assembly calls them (assemble_system.cpp).
-template void FiniteStrainSolver::Impl::assemble_foundations(const SerialAlgebra::VectorType&, const LoadState&, bool,
+template void FiniteStrainSolver::Impl::assemble_foundations(const dealii::Vector<double>&, const LoadState&, bool,
                                                              Assembly<SerialAlgebra::VectorType>&,
                                                              const dealii::AffineConstraints<double>*,
                                                              SerialAlgebra::MatrixType&, SerialAlgebra::VectorType*,
                                                              SerialAlgebra::VectorType&) const;
-template void FiniteStrainSolver::Impl::assemble_foundations(const DistributedAlgebra::VectorType&, const LoadState&,
+template void FiniteStrainSolver::Impl::assemble_foundations(const dealii::Vector<double>&, const LoadState&,
                                                              bool, Assembly<DistributedAlgebra::VectorType>&,
                                                              const dealii::AffineConstraints<double>*,
                                                              DistributedAlgebra::MatrixType&,

@@ -10,6 +10,7 @@
 #include <deal.II/fe/fe_values.h>
 
 #include <algorithm>
+#include <span>
 
 namespace kerf::reference {
 
@@ -23,8 +24,11 @@ void FiniteStrainSolver::Impl::build_dynamics() {
   // m_ij = ∫ ρ N_i N_j dV with the mass quadrature (degree + 1 points per direction: exact for
   // N_i N_j of P1; of P2 (degree 4) QGaussSimplex(3) is exact to degree 5).
   dealii::FEValues<3> fv(*mapping, scalar, *mass_quadrature, dealii::update_values | dealii::update_JxW_values);
-  d.cell_mass.resize(tria.n_active_cells());
-  for (const auto& cell : tria.active_cell_iterators()) {
+  // This process's cells (distributed: the others' are assembled there).
+  const dealii::Triangulation<3>& cells = dof.get_triangulation();
+  d.cell_mass.resize(cells.n_active_cells());
+  for (const auto& cell : cells.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue;
     fv.reinit(cell);
     const double rho = densities[cell->material_id()];
     std::vector<double> m(static_cast<std::size_t>(d.nodes) * d.nodes, 0.0);
@@ -42,6 +46,9 @@ void FiniteStrainSolver::Impl::build_dynamics() {
 }
 
 double FiniteStrainSolver::Impl::commit_dynamics(const dealii::Vector<double>& u) {
+  // Every process commits all DOFs (u is whole on every process: gathered when distributed), so
+  // that u_n, v_n and a_n are the same everywhere; the cell sums (viscous forces, kinetic energy)
+  // are this process's cells', summed over the processes.
   Dynamics& d = *dynamics;
   if (d.step > 0.0)
     for (dealii::types::global_dof_index i = 0; i < u.size(); ++i) {
@@ -55,6 +62,7 @@ double FiniteStrainSolver::Impl::commit_dynamics(const dealii::Vector<double>& u
     // ½ (f_v,n + f_v,n+1)·(u_{n+1} − u_n), the term the Newmark energy identity books for them.
     dealii::Vector<double> f_next(u.size());
     assemble_viscous_force(u, d.v, f_next);
+    sum(std::span<double>(f_next.begin(), f_next.size()));
     if (d.step > 0.0)
       for (dealii::types::global_dof_index i = 0; i < u.size(); ++i)
         d.damping_dissipation += 0.5 * (d.viscous_force[i] + f_next[i]) * (u[i] - d.u[i]);
@@ -66,6 +74,7 @@ double FiniteStrainSolver::Impl::commit_dynamics(const dealii::Vector<double>& u
   std::vector<dealii::types::global_dof_index> local(n);
   double kinetic = 0.0;
   for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue;
     cell->get_dof_indices(local);
     const std::vector<double>& m = d.cell_mass[cell->active_cell_index()];
     for (unsigned i = 0; i < n; ++i)
@@ -73,8 +82,8 @@ double FiniteStrainSolver::Impl::commit_dynamics(const dealii::Vector<double>& u
         if (fe->system_to_component_index(i).first == fe->system_to_component_index(j).first)
           kinetic += 0.5 * d.v[local[i]] * m[d.node_of_dof[i] * d.nodes + d.node_of_dof[j]] * d.v[local[j]];
   }
-  d.kinetic_energy = kinetic;
-  return kinetic;
+  d.kinetic_energy = sum(kinetic);
+  return d.kinetic_energy;
 }
 
 void FiniteStrainSolver::Impl::assemble_viscous_force(const dealii::Vector<double>& u, const dealii::Vector<double>& v,
@@ -87,6 +96,7 @@ void FiniteStrainSolver::Impl::assemble_viscous_force(const dealii::Vector<doubl
   std::vector<dealii::types::global_dof_index> local(n);
   dealii::Vector<double> cell_f(n);
   for (const auto& cell : dof.active_cell_iterators()) {
+    if (!cell->is_locally_owned()) continue; // distributed: another process's cell
     const KelvinVoigtDamping& kv = damping[cell->material_id()];
     if (kv.retardation_time == 0.0) continue;
     fv.reinit(cell);

@@ -59,14 +59,19 @@ physics() { cut -d, -f1-10 "$1"; }
 start=$(date +%s.%N)
 "$kerf" reference coarse.toml --samples $samples --adaptive 0 --no-fields -o whole > whole.log 2>&1 || { cat whole.log; fail "uninterrupted run"; }
 whole_s=$($py -c "import sys; print(max(1.0, float(sys.argv[2]) - float(sys.argv[1])))" "$start" "$(date +%s.%N)")
-[ "$(wc -l < whole/profile.csv)" -eq $((samples + 1)) ] || fail "uninterrupted profile has $(wc -l < whole/profile.csv) lines"
+# The loads solved: the requested samples and the trajectory's vertices between them (the pull's
+# end at t = 1.6 s; docs/reference.md, "The load path follows the trajectory"), as the manifest
+# counts them; each is a row of the profile and a numbered "sample k/loads" line of the log.
+loads=$($py -c "import json, sys; print(json.load(open(sys.argv[1]))['solver']['load_path']['loads_solved'])" whole/manifest.json)
+[ "$loads" -gt "$samples" ] || fail "the load path solved $loads loads for $samples samples: the pull's end is no load"
+[ "$(wc -l < whole/profile.csv)" -eq $((loads + 1)) ] || fail "uninterrupted profile has $(wc -l < whole/profile.csv) lines for $loads loads"
 check_whole whole
 # The solve's own wall time (the run's last line), without the process's start and the meshing
 # into the cache that only the first run does: under ASan + UBSan the first run takes 73 s of which
 # the solve is 8 s, and kill times scaled to 73 s would fall after the later, cached runs end.
 solve_s=$(grep -o 'wall [0-9.]* s' whole.log | tail -1 | cut -d' ' -f2)
 [ -n "$solve_s" ] || { cat whole.log; fail "no solve wall time in the uninterrupted run's log"; }
-echo "uninterrupted: $samples samples in $whole_s s (the solve $solve_s s)"
+echo "uninterrupted: $samples samples ($loads loads) in $whole_s s (the solve $solve_s s)"
 
 # 2. SIGKILL at random points, then --resume (a fixed seed: the same kill times every run).
 RANDOM=2026
@@ -75,7 +80,7 @@ kills=0
 wait_for_sample() {
   local number="$1" log="$2" pid="$3"
   for _ in $(seq 1 30000); do
-    grep -Eq "sample $number/$samples " "$log" && return
+    grep -Eq "sample $number/$loads " "$log" && return
     kill -0 "$pid" 2> /dev/null || return
     sleep 0.02
   done
@@ -166,11 +171,11 @@ check_whole full_ckpt
   || fail "the checkpoint after sample 5 is not on disk whole"
 "$kerf" reference coarse.toml --samples $samples --adaptive 0 --no-fields -o full_ckpt --resume > full_ckpt.resume.log 2>&1 \
   || { cat full_ckpt.resume.log; fail "resume after the disk filled between checkpoints"; }
-grep -q "resuming after sample 5/$samples" full_ckpt.resume.log || { cat full_ckpt.resume.log; fail "did not resume from the checkpoint after sample 5"; }
+grep -q "resuming after sample 5/$loads" full_ckpt.resume.log || { cat full_ckpt.resume.log; fail "did not resume from the checkpoint after sample 5"; }
 check_whole full_ckpt
 diff <(physics whole/profile.csv) <(physics full_ckpt/profile.csv) || fail "the profile after the disk filled and --resume differs"
 echo "full disk between checkpoints ($limit-byte limit; checkpoint after sample 10 is $ckpt10 bytes): exit $rc: $(grep -m1 'checkpoint' full_ckpt.log | cut -c1-160)"
-echo "  then --resume (resuming after sample 5/$samples): the profile equals the uninterrupted one"
+echo "  then --resume (resuming after sample 5/$loads): the profile equals the uninterrupted one"
 
 # 4. An absurd load increment: the stylus jumps 2 m up (the block is 20 mm deep) between the two
 #    samples solved.

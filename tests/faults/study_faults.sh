@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fault injection on `kerf study` (docs/reliability.md), through the command line: a
-# small study (sponge_cut_constant and potato_rect_cut, the voxel and fracture models, the
-# reference at 4 samples on the coarsest mesh: two reference solves) is SIGKILLed half way, right
+# small study (clay_pull and potato_wedge_cut, the spring network and fracture models, the
+# reference at 4 and 48 samples on coarse meshes: two reference solves) is SIGKILLed half way, right
 # after its first reference solve reached the cache. Then:
 #   - no table (study.csv, study.md, study.tex) and no cached profile is half written under its
 #     final name;
@@ -24,13 +24,18 @@ cat > faults.toml <<'TOML'
 [study]
 name = "faults"
 description = "A study small enough to kill and resume in a test."
-scenes = ["sponge_cut_constant", "potato_rect_cut"]
-models = ["voxel", "fracture"]
+scenes = ["clay_pull", "potato_wedge_cut"]
+models = ["springs", "fracture"]
 
 [reference]
 degree = 1
 refinements = [0]
 samples = 4
+scene_samples = { potato_wedge_cut = 48 } # the default study's L-1 solve of the wedge (4 mm): on its
+scene_refinements = { potato_wedge_cut = [-1] } # 8 mm level the crack front's saw-tooth (0.77 elements in the zone) makes the
+                                                # adaptive inserts sensitive to the last digit of a solve
+fracture = "auto" # the blades open the cohesive interface on the cut plane, as in the default study
+time_verification = false # two solves, one per scene: the kill falls between them
 TOML
 
 # Every file under a final name is whole: tables end with a newline and have as many columns

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <string>
 
 namespace kerf::reference {
 namespace {
@@ -30,6 +31,11 @@ TEST(AutomaticLinearSolver, DirectWhileThePredictedFactorFits) {
     settings.direct_factor_limit = limit;
     FiniteStrainSolver solver(test::affine_problem(mesh, G, b, LawKind::neo_hookean, 1e6, 0.3), settings);
     EXPECT_EQ(solver.linear_solver_name(), limit > 1.0 ? "cholmod/umfpack" : "petsc-cg-gamg");
+    // The record says why: the DOFs above the limit and the predicted factor against its limit.
+    EXPECT_NE(solver.linear_solver_reason().find(std::string(limit > 1.0 ? "direct: " : "iterative: ") +
+                                                 std::to_string(solver.dof_count()) + " DOFs > direct_dof_limit 0; predicted Cholesky factor"),
+              std::string::npos)
+        << solver.linear_solver_reason();
     const EquilibriumReport r = solver.solve({1.0, Eigen::Vector3d::Zero()});
     ASSERT_TRUE(r.converged) << r.failure;
     EXPECT_LT((solver.displacement_at(X) - (G * X + b)).norm(), 1e-9 * (G * X + b).norm()) << "factor limit " << limit;

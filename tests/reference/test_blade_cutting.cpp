@@ -60,7 +60,7 @@ BladeRun run_blade(const Scene& scene, const TetMesh& mesh, std::size_t last, co
   std::filesystem::remove_all(dir);
   BladeRun run;
   run.dir = dir;
-  run.profile = run_reference(scene, mesh, settings, dir);
+  run.profile = run_reference(scene, mesh, settings, dir).profile;
   run.samples_asked = settings.sample_indices.size();
   std::ifstream(dir / "manifest.json") >> run.manifest;
   return run;

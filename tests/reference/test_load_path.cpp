@@ -110,5 +110,49 @@ TEST(LoadPath, NaNInTheResidualIsAFailedSolveAndIsCutBack) {
   EXPECT_LT((solver.displacement_at(X) - clean.displacement_at(X)).norm(), 1e-9 * clean.displacement_at(X).norm());
 }
 
+// Between two targets the load path follows the motion it is given (reference/load_path.hpp): the
+// sub-loads of a cut-back are the motion at their own time, not points of the chord between the
+// two targets. The motion here turns a corner half way (the tool goes 2 mm along x, then 2 mm back
+// along y) while the cube's top is stretched by the load factor t: every load the solver is asked
+// to solve (seen through the residual hook, which receives it) lies on the motion, and the cut-back
+// that halves the increment asks for the corner itself, (2, 0, 0) mm, not the chord's midpoint
+// (1, 1, 0) mm.
+TEST(LoadPath, CutBacksFollowTheMotionNotTheChord) {
+  const FiniteStrainProblem p = stretched_cube();
+  const auto motion = [](double t) {
+    const Eigen::Vector3d corner(2e-3, 0.0, 0.0);
+    const Eigen::Vector3d at = t <= 0.5 ? Eigen::Vector3d(corner * (t / 0.5)) : Eigen::Vector3d(corner + Eigen::Vector3d(0.0, 2e-3, 0.0) * ((t - 0.5) / 0.5));
+    return LoadState{t, at, t};
+  };
+  std::vector<LoadState> asked;
+  SolverSettings tight;
+  tight.max_newton_iterations = 3; // too few for the whole 40% stretch in one increment: it is cut back
+  tight.residual_fault = [&asked](const LoadState& load, int iteration) {
+    if (iteration == 0) asked.push_back(load);
+    return false;
+  };
+  FiniteStrainSolver solver(p, tight);
+  LoadPath path(solver, motion(0.0), LoadPathSettings{}, motion);
+  const LoadStepReport r = path.advance({motion(1.0), 1, 1.0});
+  ASSERT_TRUE(r.converged);
+  ASSERT_GE(r.cutbacks, 1);
+  bool corner_asked = false;
+  for (const LoadState& load : asked) {
+    EXPECT_LT((load.tool_position - motion(load.time).tool_position).norm(), 1e-15) << "t = " << load.time;
+    EXPECT_NEAR(load.load_factor, load.time, 1e-15);
+    corner_asked = corner_asked || std::abs(load.time - 0.5) < 1e-12;
+  }
+  EXPECT_TRUE(corner_asked);
+  // Without a motion the same cut-back interpolates the chord: its half-way load is (1, 1, 0) mm.
+  asked.clear();
+  FiniteStrainSolver chord_solver(p, tight);
+  LoadPath chord(chord_solver, motion(0.0));
+  ASSERT_TRUE(chord.advance({motion(1.0), 1, 1.0}).converged);
+  bool chord_midpoint = false;
+  for (const LoadState& load : asked)
+    chord_midpoint = chord_midpoint || (load.tool_position - Eigen::Vector3d(1e-3, 1e-3, 0.0)).norm() < 1e-15;
+  EXPECT_TRUE(chord_midpoint);
+}
+
 } // namespace
 } // namespace kerf::reference

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -102,6 +103,32 @@ TEST(SparseDirect, PredictsTheCholeskyFactorsEntries) {
   }
   SparseDirect dense(n, row_start, columns);
   EXPECT_EQ(dense.cholesky_factor_entries(), static_cast<double>(n * (n + 1) / 2));
+  // Without a solver (the distributed automatic choice's prediction): the same closed forms.
+  EXPECT_EQ(SparseDirect::predict_cholesky_factor_entries(t.n, t.row_start, t.columns), 2.0 * 300 - 1);
+  EXPECT_EQ(SparseDirect::predict_cholesky_factor_entries(n, row_start, columns), static_cast<double>(n * (n + 1) / 2));
+}
+
+// The prediction without a solver is the solver's own (one analysis of one lower triangle), on a
+// pattern with fill: the 7-point stencil of a 12 × 12 × 12 grid, each row's diagonal first.
+TEST(SparseDirect, PredictionWithoutASolverIsTheSolversOwn) {
+  const int m = 12;
+  const auto index = [&](int i, int j, int k) { return static_cast<std::int64_t>((k * m + j) * m + i); };
+  std::vector<std::int64_t> row_start{0}, columns;
+  for (int k = 0; k < m; ++k)
+    for (int j = 0; j < m; ++j)
+      for (int i = 0; i < m; ++i) {
+        columns.push_back(index(i, j, k));
+        for (const auto& [di, dj, dk] : {std::array{-1, 0, 0}, std::array{1, 0, 0}, std::array{0, -1, 0}, std::array{0, 1, 0},
+                                         std::array{0, 0, -1}, std::array{0, 0, 1}})
+          if (i + di >= 0 && i + di < m && j + dj >= 0 && j + dj < m && k + dk >= 0 && k + dk < m)
+            columns.push_back(index(i + di, j + dj, k + dk));
+        row_start.push_back(static_cast<std::int64_t>(columns.size()));
+      }
+  const std::size_t n = static_cast<std::size_t>(m * m * m);
+  SparseDirect solver(n, row_start, columns);
+  const double entries = solver.cholesky_factor_entries();
+  EXPECT_GT(entries, static_cast<double>(columns.size() + n) / 2.0); // fill: more than the lower triangle
+  EXPECT_EQ(SparseDirect::predict_cholesky_factor_entries(n, row_start, columns), entries);
 }
 
 TEST(SparseDirect, RefusesValuesThatDoNotMatchThePattern) {

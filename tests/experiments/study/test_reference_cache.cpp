@@ -190,7 +190,7 @@ TEST(ReferenceCache, AProfileCachedByAnotherSolverVersionIsRecomputedNeverRead) 
   fs::create_directories(dir);
   const fs::path study_file = dir / "v.toml";
   std::ofstream(study_file) << "[study]\nname = \"v\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n"
-                               "[reference]\ndegree = 1\nrefinements = [0]\nsamples = 3\n";
+                               "[reference]\ndegree = 1\nrefinements = [0]\nsamples = 3\ntime_verification = false\n";
   const StudySpec spec = read_study(study_file);
   const fs::path out = dir / "out";
   const Scene scene = clay_pull();
@@ -213,8 +213,7 @@ TEST(ReferenceCache, AProfileCachedByAnotherSolverVersionIsRecomputedNeverRead) 
   write_profile_csv(stale, out / "cache" / old_key.directory / "profile.csv");
 
   int solves = 0;
-  const ReferenceRunner fresh = [&](const Scene&, const StudyReferenceSpec&, int, const std::vector<std::size_t>&,
-                                    const fs::path&) {
+  const ReferenceRunner fresh = [&](const StudyReferenceSolve&, const StudyReferenceSpec&) -> ReferenceResult {
     ++solves;
     ForceProfile p = stale;
     for (ProfileRow& r : p.rows) r.force = Eigen::Vector3d(0.0, 0.0, 1.0);

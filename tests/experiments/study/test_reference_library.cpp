@@ -13,6 +13,11 @@
 #include "realtime/blas_threads.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/study/study_spec.hpp"
+#include "experiments/calibration/calibration.hpp"
+#include "experiments/scene/scene_mesh.hpp"
+#include "experiments/scene/scene_reader.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
 
@@ -57,7 +62,7 @@ TEST(ReferenceLibrary, EveryEntryIsAPlannedSolveUnderItsCurrentKey) {
     planned[s.dir.filename().string()] = s.key_text;
   int entries = 0;
   for (const auto& e : fs::directory_iterator(spec.reference.library)) {
-    if (!e.is_directory()) continue;
+    if (!e.is_directory() || e.path().filename() == "fits") continue; // fitted calibrations: below
     ++entries;
     const std::string name = e.path().filename().string();
     SCOPED_TRACE(name);
@@ -91,7 +96,10 @@ TEST(ReferenceLibrary, FirstSamplesOfEveryEntryResolveToItsForces) {
         break;
       }
     const std::vector<std::size_t> first(s.indices.begin(), s.indices.begin() + std::min(count, s.indices.size()));
-    const ForceProfile again = solve(s.scene, spec.reference, s.level, first, work / s.dir.filename());
+    StudyReferenceSolve head = s;
+    head.indices = first;
+    head.dir = work / s.dir.filename();
+    const ForceProfile again = solve(head, spec.reference).profile;
     double peak = 0.0;
     for (const ProfileRow& r : kept.rows) peak = std::max(peak, r.force.norm());
     const auto kept_force = force_by_row(kept);
@@ -108,6 +116,49 @@ TEST(ReferenceLibrary, FirstSamplesOfEveryEntryResolveToItsForces) {
   }
   fs::remove_all(work);
   EXPECT_GT(checked, 0) << "no library entry to check";
+}
+
+// Every fitted calibration the library holds (library/fits/, written by --publish-references from
+// the study's [[calibrate]] fits) is one the default study plans under its current key, and its
+// parameters, run now on its calibration trajectory, give the fitted error it recorded against its
+// target — the library's reference solve of that trajectory — to 1e-9 relative: the fast model
+// computes what it computed when it was fitted. A model whose numbers changed fails here, naming
+// the version to bump (study_fit_version) and the command that re-publishes.
+TEST(ReferenceLibrary, EveryFitGivesItsRecordedErrorOnItsTarget) {
+  const StudySpec spec = read_study(default_study);
+  const fs::path work = fs::temp_directory_path() / ("kerf_library_fits_" + std::to_string(::getpid()));
+  const StudyPlan plan = plan_study(spec, work);
+  int checked = 0;
+  for (const StudyFitRun& run : plan.fit_runs) {
+    if (!run.reference) continue;
+    const Scene& scene = plan.scenes[run.scene].scene;
+    const StudyReferenceSolve& target = plan.solves[*run.reference];
+    SCOPED_TRACE(scene.name + " " + run.fit.model);
+    fs::path entry;
+    if (fs::exists(spec.reference.library / "fits"))
+      for (const auto& e : fs::directory_iterator(spec.reference.library / "fits"))
+        if (e.path().filename().string().rfind(scene.name + "-" + run.fit.model + "-", 0) == 0) entry = e.path();
+    ASSERT_FALSE(entry.empty()) << "the library holds no fit of " << run.fit.model << " on " << scene.name << ": " << republish;
+    std::ifstream in(entry / "fit.json");
+    const nlohmann::json record = nlohmann::json::parse(in);
+    ASSERT_EQ(record.at("target").get<std::string>(), target.dir.filename().string()) << "the fit's target is no planned solve: " << republish;
+    const ForceProfile target_profile = read_profile_csv(spec.reference.library / target.dir.filename() / "profile.csv");
+    // As the fit evaluated it: the target's scene (the calibration trajectory at the finest level)
+    // with the fitted parameters, the model built on the scene's own mesh (StudyRun::fit).
+    const Scene fitted = read_scene(scene.file, {entry / "parameters.toml"});
+    const Scene on_target = with_parameters(target.scene, scene_parameters(run.fit.model, fitted));
+    const double error = profile_error(run.fit.model, on_target, scene_mesh(scene), target_profile);
+    const double recorded = record.at("fitted_error").get<double>();
+    // 1e-5 of the recorded error: the parameter file keeps 9 significant digits, and a spring
+    // network solved to its Newton tolerance moves by that tolerance's order (clay_pull's springs:
+    // 9e-7 relative) when a parameter moves in its 10th digit; a changed model moves it by percents.
+    EXPECT_NEAR(error, recorded, 1e-5 * recorded)
+        << "the fitted " << run.fit.model << " no longer gives its recorded error: bump study_fit_version (study_runner.hpp) and "
+        << republish;
+    ++checked;
+  }
+  EXPECT_EQ(checked, static_cast<int>(plan.fit_runs.size()));
+  fs::remove_all(work);
 }
 
 } // namespace

@@ -33,7 +33,9 @@ namespace {
 constexpr double scale_at_h0 = 0.004;
 
 ReferenceRunner power_law_reference() {
-  return [](const Scene& scene, const StudyReferenceSpec&, int, const std::vector<std::size_t>& indices, const fs::path&) {
+  return [](const StudyReferenceSolve& solve, const StudyReferenceSpec&) -> ReferenceResult {
+    const Scene& scene = solve.scene;
+    const std::vector<std::size_t>& indices = solve.indices;
     const double h = scene.geometry.element_size;
     Scene own = scene;
     own.geometry.element_size = 2e-3;
@@ -157,7 +159,8 @@ TEST(StudyReport, FewerThanThreeLevelsSayNoGciIsAvailable) {
   const fs::path dir = fs::temp_directory_path() / ("kerf_test_study_report2_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const StudySpec spec = read_study(write_file(dir / "two.toml", "[study]\nname = \"two\"\nscenes = [\"potato_rect_cut\"]\n"
-                                                                 "models = [\"fracture\"]\n[reference]\nrefinements = [-1, 0]\nsamples = 6\n"));
+                                                                 "models = [\"fracture\"]\n[reference]\nrefinements = [-1, 0]\nsamples = 6\n"
+                                                                 "time_verification = false\n"));
   const StudyResult r = run_study(spec, dir / "out", power_law_reference());
   ASSERT_EQ(r.rows.size(), 3u);
   EXPECT_EQ(r.rows[0].model, "reference L0");
@@ -302,12 +305,12 @@ TEST(StudyReport, ACoarseLevelThatFailsIsLeftOutSayingWhy) {
   const fs::path dir = fs::temp_directory_path() / ("kerf_test_study_report3_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   const StudySpec spec = read_study(write_file(dir / "fail.toml", "[study]\nname = \"fail\"\nscenes = [\"potato_rect_cut\"]\n"
-                                                                  "models = [\"fracture\"]\n[reference]\nrefinements = [-2, -1, 0]\nsamples = 6\n"));
+                                                                  "models = [\"fracture\"]\n[reference]\nrefinements = [-2, -1, 0]\nsamples = 6\n"
+                                                                  "time_verification = false\n"));
   const ReferenceRunner inner = power_law_reference();
-  const ReferenceRunner failing = [&](const Scene& scene, const StudyReferenceSpec& settings, int level,
-                                      const std::vector<std::size_t>& indices, const fs::path& d) {
-    if (scene.geometry.element_size > 7e-3) throw std::runtime_error("no node within the grasp");
-    return inner(scene, settings, level, indices, d);
+  const ReferenceRunner failing = [&](const StudyReferenceSolve& solve, const StudyReferenceSpec& settings) {
+    if (solve.scene.geometry.element_size > 7e-3) throw std::runtime_error("no node within the grasp");
+    return inner(solve, settings);
   };
   const StudyResult r = run_study(spec, dir / "out", failing);
   ASSERT_EQ(r.rows.size(), 3u); // reference L0, reference L-1, fracture
@@ -315,10 +318,9 @@ TEST(StudyReport, ACoarseLevelThatFailsIsLeftOutSayingWhy) {
   EXPECT_NE(r.rows[0].note.find("no GCI available: 2 mesh level(s)"), std::string::npos) << r.rows[0].note;
   ASSERT_TRUE(r.rows[2].metrics.has_value());
   // The finest level failing leaves nothing to score against: an error.
-  const ReferenceRunner finest_fails = [&](const Scene& scene, const StudyReferenceSpec& settings, int level,
-                                           const std::vector<std::size_t>& indices, const fs::path& d) -> ForceProfile {
-    if (scene.geometry.element_size < 3e-3) throw std::runtime_error("diverged");
-    return inner(scene, settings, level, indices, d);
+  const ReferenceRunner finest_fails = [&](const StudyReferenceSolve& solve, const StudyReferenceSpec& settings) {
+    if (solve.scene.geometry.element_size < 3e-3) throw std::runtime_error("diverged");
+    return inner(solve, settings);
   };
   EXPECT_THROW(run_study(spec, dir / "out2", finest_fails), std::runtime_error);
   fs::remove_all(dir);

@@ -248,25 +248,33 @@ TEST(StudyRunner, EndToEndWithTheReferenceAndItsCache) {
   // note says why). A second run takes the reference from the cache: no reference solve.
   const StudySpec spec = read_study(write_study(
       "e2e.toml", "[study]\nname = \"e2e\"\nscenes = [\"clay_pull\", \"potato_wedge_cut\"]\n"
-                  "models = [\"springs\", \"fracture\"]\n[reference]\ndegree = 1\nrefinements = [0]\nsamples = 4\n"));
+                  "models = [\"springs\", \"fracture\"]\n[reference]\ndegree = 1\nrefinements = [0]\nsamples = 4\nadaptive = 0\n"));
   const fs::path out = fs::temp_directory_path() / ("kerf_test_study_e2e_" + std::to_string(::getpid()));
   fs::remove_all(out);
-  const StudyResult first = run_study(spec, out, finite_element_reference());
-  EXPECT_EQ(first.reference_runs, 2);
+  StudyExecution execution;
+  execution.timing_runs = 1;
+  const StudyResult first = run_study(spec, out, finite_element_reference(), execution);
+  // Each scene's level and the same level at half the load increment (the verification in time).
+  EXPECT_EQ(first.reference_runs, 4);
   bool scored = false;
   for (const StudyRow& row : first.rows) {
     if (row.scene == "clay_pull" && row.model == "springs") {
       ASSERT_TRUE(row.metrics.has_value()) << row.note;
       EXPECT_TRUE(std::isfinite(row.metrics->normalised_rms_force_error));
-      EXPECT_EQ(row.metrics->samples, 4u);
+      // The 4 requested samples and the end of the pull at t = 1.6 s, a vertex of the motion.
+      EXPECT_EQ(row.metrics->samples, 5u);
       scored = true;
     }
     if (row.scene == "potato_wedge_cut") { // its reference first; springs there: the blade's deformation phase
-      EXPECT_TRUE(row.model == "reference L0" || row.model == "fracture" || row.model == "springs") << row.model;
+      EXPECT_TRUE(row.model == "reference L0" || row.model == "reference L0 (half increment)" || row.model == "fracture" ||
+                  row.model == "springs")
+          << row.model;
     }
   }
   EXPECT_TRUE(scored);
-  const StudyResult second = run_study(spec, out, finite_element_reference());
+  // Verified in time: the first row of each scene says how far the half increment moves the profile.
+  EXPECT_NE(first.rows[0].note.find("sampling uncertainty"), std::string::npos) << first.rows[0].note;
+  const StudyResult second = run_study(spec, out, finite_element_reference(), execution);
   EXPECT_EQ(second.reference_runs, 0);
   ASSERT_EQ(second.rows.size(), first.rows.size());
   for (std::size_t k = 0; k < first.rows.size(); ++k) {
@@ -316,16 +324,18 @@ TEST(StudyRunner, ParallelRunsGiveTheSerialTablesApartFromCosts) {
   std::ofstream(dir / "calibration" / "fracture.toml") << "[models.fracture]\nrupture_force_per_length = \"350 N/m\"\n";
   const StudySpec spec = read_study(write_study(
       "jobs.toml", "[study]\nname = \"jobs\"\nscenes = [\"potato_rect_cut\", \"potato_wedge_cut\"]\n"
-                   "models = [\"fracture\", \"edge\", \"springs\"]\n[reference]\nrefinements = [0]\nsamples = 40\n"
+                   "models = [\"fracture\", \"edge\", \"springs\"]\n[reference]\nrefinements = [0]\nsamples = 40\ntime_verification = false\n"
                    "[calibration]\npotato_rect_cut = [\"" + (dir / "calibration" / "fracture.toml").string() + "\"]\n"));
   // The fake reference: the fracture model's profile of the scene at the chosen samples.
-  const ReferenceRunner fake = [](const Scene& scene, const StudyReferenceSpec&, int, const std::vector<std::size_t>& indices,
-                                  const fs::path&) {
+  const ReferenceRunner fake = [](const StudyReferenceSolve& solve, const StudyReferenceSpec&) -> ReferenceResult {
+    const Scene& scene = solve.scene;
+    const std::vector<std::size_t>& indices = solve.indices;
     const TetMesh mesh = scene_mesh(scene);
     BuiltModel built = make_model("fracture", scene, mesh);
     return subsample(run_model(*built.model, {scene.tools.front().name}, sample_scene_trajectories(scene)), indices);
   };
   StudyExecution serial, parallel;
+  serial.timing_runs = parallel.timing_runs = 1;
   parallel.jobs = 3;
   const fs::path a = dir / "serial", b = dir / "parallel";
   fs::remove_all(a);
@@ -341,7 +351,7 @@ TEST(StudyRunner, ParallelRunsGiveTheSerialTablesApartFromCosts) {
   EXPECT_EQ(three.reference_runs, 2);
   const std::string csv_one = one.table().csv(), csv_three = three.table().csv();
   EXPECT_NE(csv_one.find("p99 cost"), std::string::npos);
-  // The filter drops exactly the four cost columns (median, p99, max, rate allowed) of 13.
+  // The filter drops exactly the five cost columns (median, p99, p99 spread, max, rate allowed) of 14.
   const std::string header = without_cost_columns(csv_one.substr(0, csv_one.find('\n')));
   EXPECT_EQ(std::count(header.begin(), header.end(), ','), 9);
   // Same tables to round-off: a run beside others may sum its samples in another order (a metric of
@@ -395,11 +405,36 @@ TEST(StudySpec, ReadsSolverSettingsAndFittedCalibrations) {
   EXPECT_EQ(d.reference.fracture, ReferenceFracture::off);
 }
 
+TEST(StudySpec, ReadsTheReferencesSamplingAndItsVerificationInTime) {
+  // Defaults: adaptive sampling at 20 % of the peak, the finest level verified in time.
+  const std::string head = "[study]\nname = \"t\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\"]\n[reference]\n";
+  const StudySpec defaults = read_study(write_study("sampling0.toml", head));
+  EXPECT_EQ(defaults.reference.adaptive, 0.2);
+  EXPECT_TRUE(defaults.reference.time_verification);
+  const StudySpec set = read_study(write_study("sampling1.toml", head + "adaptive = 0\ntime_verification = false\n"));
+  EXPECT_EQ(set.reference.adaptive, 0.0);
+  EXPECT_FALSE(set.reference.time_verification);
+  // Into each solve's settings: the force change, and a least travel of 1/40 of the scene's element
+  // size (clay_pull: 2.5 mm) at every level, halved at half the increment.
+  const Scene clay = read_scene(fs::path(KERF_SCENES_DIR) / "clay_pull.toml");
+  for (int level : {-2, 0}) {
+    const Scene s = study_reference_scene(clay, level);
+    const ReferenceRunSettings whole = study_reference_settings(defaults.reference, s, level, {0, 1}, LoadIncrement::whole);
+    const ReferenceRunSettings half = study_reference_settings(defaults.reference, s, level, {0, 1}, LoadIncrement::half);
+    EXPECT_EQ(whole.adaptive_force_change, 0.2);
+    EXPECT_DOUBLE_EQ(whole.adaptive_min_travel, 2.5e-3 / 40.0) << level;
+    EXPECT_DOUBLE_EQ(half.adaptive_min_travel, 2.5e-3 / 80.0) << level;
+  }
+}
+
 TEST(StudySpec, BadSolverSettingsAndFitsNameFileLineColumnAndKey) {
   const std::string head = "[study]\nname = \"t\"\nscenes = [\"clay_pull\"]\nmodels = [\"springs\", \"edge\"]\n[reference]\n";
   const std::pair<std::string, std::string> cases[] = {
       {head + "linear_solver = \"cholesky\"\n", ":6:17: reference.linear_solver"},
       {head + "fracture = \"yes\"\n", ":6:12: reference.fracture"},
+      {head + "adaptive = 1.5\n", ":6:12: reference.adaptive"},
+      {head + "adaptive = -0.1\n", ":6:12: reference.adaptive"},
+      {head + "time_verification = 1\n", ":6:21: reference.time_verification"},
       {head + "[[calibrate]]\nscene = \"potato_rect_cut\"\nmodel = \"springs\"\n", ":7:9: calibrate.scene"},
       {head + "[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"voxel\"\n", ":8:9: calibrate.model"},
       {head + "[[calibrate]]\nscene = \"clay_pull\"\nmodel = \"edge\"\n", ":8:9: calibrate.model"}, // no free parameters
@@ -427,8 +462,9 @@ namespace {
 /// A stand-in for the finite-element reference, counting its solves: the fracture model's profile
 /// of the scene at the chosen samples, with f_r = `rupture_force_per_length` (the "truth").
 ReferenceRunner fracture_as_reference(std::atomic<int>& solves, double rupture_force_per_length) {
-  return [&solves, rupture_force_per_length](const Scene& scene, const StudyReferenceSpec&, int,
-                                             const std::vector<std::size_t>& indices, const fs::path&) {
+  return [&solves, rupture_force_per_length](const StudyReferenceSolve& solve, const StudyReferenceSpec&) -> ReferenceResult {
+    const Scene& scene = solve.scene;
+    const std::vector<std::size_t>& indices = solve.indices;
     ++solves;
     Scene truth = scene;
     truth.fracture->rupture_force_per_length = rupture_force_per_length;
@@ -444,7 +480,8 @@ TEST(StudyRunner, AChangedSolverSettingMissesTheCacheAnUnchangedOneHitsIt) {
   // The reference is cached by the hash of the scene and the solver settings. One scene,
   // one level: each run below says how many reference solves it did.
   StudySpec spec = read_study(write_study("cache.toml", "[study]\nname = \"cache\"\nscenes = [\"potato_rect_cut\"]\n"
-                                                        "models = [\"fracture\"]\n[reference]\nrefinements = [0]\nsamples = 8\n"));
+                                                        "models = [\"fracture\"]\n[reference]\nrefinements = [0]\nsamples = 8\n"
+                                                        "time_verification = false\n"));
   const fs::path out = fs::temp_directory_path() / ("kerf_test_study_cache_" + std::to_string(::getpid()));
   fs::remove_all(out);
   std::atomic<int> solves{0};
@@ -468,6 +505,7 @@ TEST(StudyRunner, AChangedSolverSettingMissesTheCacheAnUnchangedOneHitsIt) {
   EXPECT_EQ(run(), 1);
   spec.reference = StudyReferenceSpec{}; // back to the first settings: still cached
   spec.reference.samples = 8;
+  spec.reference.time_verification = false;
   EXPECT_EQ(run(), 0);
   // One entry per distinct setting, each with its key written beside the profile.
   int entries = 0;
@@ -484,20 +522,20 @@ TEST(StudyRunner, ACoarseLevelIsItsOwnSolveOnTheCoarserMesh) {
   // fracture model on the scene's own mesh plus (h / 2 mm - 1) x 1 N along x: the L-1 profile is
   // the finest one offset by exactly 1 N at every sample, so its RMS error is 1 N / max|f_L0|.
   StudySpec spec = read_study(write_study("levels.toml", "[study]\nname = \"levels\"\nscenes = [\"potato_rect_cut\"]\n"
-                                                         "models = [\"fracture\"]\n[reference]\nrefinements = [-1, 0]\nsamples = 8\n"));
+                                                         "models = [\"fracture\"]\n[reference]\nrefinements = [-1, 0]\nsamples = 8\n"
+                                                         "time_verification = false\n"));
   const fs::path out = fs::temp_directory_path() / ("kerf_test_study_levels_" + std::to_string(::getpid()));
   fs::remove_all(out);
   std::atomic<int> solves{0};
   std::vector<double> sizes;
   double finest_peak = 0.0;
   const ReferenceRunner truth = fracture_as_reference(solves, 300.0);
-  const ReferenceRunner offset = [&](const Scene& scene, const StudyReferenceSpec& settings, int level,
-                                     const std::vector<std::size_t>& indices, const fs::path& dir) {
-    const double h = scene.geometry.element_size;
+  const ReferenceRunner offset = [&](const StudyReferenceSolve& solve, const StudyReferenceSpec& settings) -> ReferenceResult {
+    const double h = solve.scene.geometry.element_size;
     sizes.push_back(h);
-    Scene own = scene;
-    own.geometry.element_size = 2e-3;
-    ForceProfile p = truth(own, settings, level, indices, dir);
+    StudyReferenceSolve own = solve;
+    own.scene.geometry.element_size = 2e-3;
+    ForceProfile p = truth(own, settings).profile;
     for (ProfileRow& r : p.rows) {
       r.force.x() += h / 2e-3 - 1.0;
       if (h == 2e-3) finest_peak = std::max(finest_peak, r.force.norm());
@@ -534,7 +572,7 @@ TEST(StudyRunner, AFittedCalibrationIsScoredOnTheHeldOutTrajectory) {
   fs::remove_all(dir);
   const StudySpec spec = read_study(write_study(
       "fit.toml", "[study]\nname = \"fit\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\", \"edge\"]\n"
-                  "[reference]\nrefinements = [0]\nsamples = 40\nfracture = \"auto\"\n"
+                  "[reference]\nrefinements = [0]\nsamples = 40\nfracture = \"auto\"\ntime_verification = false\n"
                   "[[calibrate]]\nscene = \"potato_rect_cut\"\nmodel = \"fracture\"\nspeed = 2.0\nmax_evaluations = 10\n"));
   std::atomic<int> solves{0};
   const StudyResult r = run_study(spec, dir, fracture_as_reference(solves, 500.0));
@@ -571,10 +609,11 @@ TEST(StudyRunner, AFitAgainstAForcelessReferenceSaysWhy) {
   fs::remove_all(dir);
   const StudySpec spec = read_study(write_study(
       "fit0.toml", "[study]\nname = \"fit0\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n"
-                   "[reference]\nrefinements = [0]\nsamples = 6\nfracture = \"on\"\n"
+                   "[reference]\nrefinements = [0]\nsamples = 6\nfracture = \"on\"\ntime_verification = false\n"
                    "[[calibrate]]\nscene = \"potato_rect_cut\"\nmodel = \"fracture\"\nspeed = 0.5\n"));
-  const ReferenceRunner forceless = [](const Scene& scene, const StudyReferenceSpec&, int, const std::vector<std::size_t>& indices,
-                                       const fs::path&) {
+  const ReferenceRunner forceless = [](const StudyReferenceSolve& solve, const StudyReferenceSpec&) -> ReferenceResult {
+    const Scene& scene = solve.scene;
+    const std::vector<std::size_t>& indices = solve.indices;
     ForceProfile p;
     const SampledTrajectory t = sample_scene_trajectories(scene).front();
     for (std::size_t k : indices) {
@@ -601,18 +640,24 @@ TEST(StudyRunner, AReferenceThatStoppedShortSaysSoOnItsRow) {
   fs::remove_all(dir);
   const StudySpec spec = read_study(write_study(
       "stopped.toml", "[study]\nname = \"stopped\"\nscenes = [\"potato_wedge_cut\"]\nmodels = [\"fracture\"]\n"
-                      "[reference]\nrefinements = [0]\nsamples = 6\n"));
-  const ReferenceRunner stops_half_way = [](const Scene& scene, const StudyReferenceSpec&, int,
-                                            const std::vector<std::size_t>& indices, const fs::path& out) {
+                      "[reference]\nrefinements = [0]\nsamples = 6\ntime_verification = false\n"));
+  const ReferenceRunner stops_half_way = [](const StudyReferenceSolve& solve, const StudyReferenceSpec&) -> ReferenceResult {
+    const Scene& scene = solve.scene;
+    const std::vector<std::size_t>& indices = solve.indices;
+    const fs::path& out = solve.dir;
     const TetMesh mesh = scene_mesh(scene);
     BuiltModel built = make_model("fracture", scene, mesh);
     const std::vector<std::size_t> reached(indices.begin(), indices.begin() + static_cast<long>(indices.size() / 2));
     fs::create_directories(out);
-    std::ofstream(out / "manifest.json") << R"({"stopped": "load path: sample 9 did not converge after 6 cut-backs"})";
-    return subsample(run_model(*built.model, {scene.tools.front().name}, sample_scene_trajectories(scene)), reached);
+    const std::string why = "load path: sample 9 did not converge after 6 cut-backs";
+    std::ofstream(out / "manifest.json") << R"({"stopped": ")" << why << R"("})";
+    return ReferenceResult{subsample(run_model(*built.model, {scene.tools.front().name}, sample_scene_trajectories(scene)), reached), why};
   };
   const StudyResult r = run_study(spec, dir, stops_half_way);
   ASSERT_FALSE(r.rows.empty());
+  // The study lists it among the stopped references: `kerf study` ends with status 4 after writing its tables.
+  ASSERT_EQ(r.stopped_references.size(), 1u);
+  EXPECT_NE(r.stopped_references.front().find("potato_wedge_cut L0: load path: sample 9"), std::string::npos) << r.stopped_references.front();
   EXPECT_EQ(r.rows[0].model, "reference L0");
   EXPECT_NE(r.rows[0].note.find("L0 stopped before the trajectory's end (load path: sample 9 did not converge"),
             std::string::npos)
@@ -655,7 +700,7 @@ TEST(StudyRunner, NoFitToTheUncutReferenceOfACuttingScene) {
   fs::remove_all(dir);
   const StudySpec spec = read_study(write_study(
       "fitoff.toml", "[study]\nname = \"fitoff\"\nscenes = [\"potato_rect_cut\"]\nmodels = [\"fracture\"]\n"
-                     "[reference]\nrefinements = [0]\nsamples = 6\n"
+                     "[reference]\nrefinements = [0]\nsamples = 6\ntime_verification = false\n"
                      "[[calibrate]]\nscene = \"potato_rect_cut\"\nmodel = \"fracture\"\n"));
   std::atomic<int> solves{0};
   const StudyResult r = run_study(spec, dir, fracture_as_reference(solves, 500.0));
@@ -693,12 +738,14 @@ TEST(StudySpec, TheDefaultStudyCarriesCalibratedRows) {
   EXPECT_EQ(fits, (std::set<std::pair<std::string, std::string>>{
                       {"clay_pull", "springs"}, {"potato_rect_cut", "fracture"}, {"potato_wedge_cut", "fracture"},
                       {"sponge_knife_cut_proportional", "voxel"}}));
-  // Solution verification: three mesh levels for every scene (Reference III): clay_pull's finest
-  // the scene's own mesh, the potato cuts' finest a crack path of 0.25 mm, half their own
-  // ([reference] scene_refinements), the rectangular cut on more samples ([reference] scene_samples).
+  // Solution verification: three mesh levels for every scene (Reference III). The default study
+  // keeps its library affordable: clay_pull and the potato cuts on [-2, -1, 0], their finest the
+  // scene's own mesh (the potatoes' 1 mm level is the full study's, experiments/studies/full.toml);
+  // the sponge's finest half its own ([reference] scene_refinements); the potato cuts on more
+  // samples ([reference] scene_samples).
   EXPECT_EQ(s.reference.levels_of("clay_pull"), (std::vector<int>{-2, -1, 0}));
-  EXPECT_EQ(s.reference.levels_of("potato_rect_cut"), (std::vector<int>{-1, 0, 1}));
-  EXPECT_EQ(s.reference.levels_of("potato_wedge_cut"), (std::vector<int>{-1, 0, 1}));
+  EXPECT_EQ(s.reference.levels_of("potato_rect_cut"), (std::vector<int>{-2, -1, 0}));
+  EXPECT_EQ(s.reference.levels_of("potato_wedge_cut"), (std::vector<int>{-2, -1, 0}));
   EXPECT_EQ(s.reference.levels_of("sponge_knife_cut_proportional"), (std::vector<int>{-1, 0, 1}));
   EXPECT_GT(s.reference.samples_of("potato_rect_cut"), s.reference.samples);
   // The shipped references, beside the study files.
@@ -824,3 +871,240 @@ TEST(StudySpec, TheFullStudyVerifiesItsReferenceAndSweepsTheSprings) {
   ASSERT_TRUE(s.resolutions.count("springs"));
   EXPECT_GE(s.resolutions.at("springs").size(), 2u);
 }
+
+namespace kerf {
+namespace {
+
+TEST(CostTiming, TheMedianOfTheRunsAndTheSpreadOfTheirP99) {
+  // Five runs of 200 steps; run r costs (r + 1) µs per step except its two slowest steps, 50 µs.
+  // Each run's p99 over 200 steps (the nearest-rank 99th percentile, run_model.hpp) is (r + 1) µs,
+  // its median (r + 1) µs and its max 50 µs; runs in the order 3, 1, 5, 2, 4 µs.
+  const int order[] = {2, 0, 4, 1, 3};
+  int call = 0;
+  const auto run = [&] {
+    const double c = (order[call++] + 1) * 1e-6;
+    ForceProfile p;
+    for (int k = 0; k < 200; ++k) {
+      ProfileRow row;
+      row.tool = "blade";
+      row.t = k * 1e-3;
+      row.cost_s = k < 2 ? 50e-6 : c;
+      p.rows.push_back(row);
+    }
+    return p;
+  };
+  const ForceProfile scored = run();
+  call = 0;
+  const TimedCost t = time_model_runs(run, 5, &scored);
+  EXPECT_EQ(t.runs, 5);
+  EXPECT_EQ(t.steps, 200u);
+  EXPECT_DOUBLE_EQ(t.p99, 3e-6);
+  EXPECT_DOUBLE_EQ(t.p99_low, 1e-6);
+  EXPECT_DOUBLE_EQ(t.p99_high, 5e-6);
+  EXPECT_DOUBLE_EQ(t.median, 3e-6);
+  EXPECT_DOUBLE_EQ(t.max, 50e-6);
+  EXPECT_NEAR(t.p99_spread(), 4.0 / 3.0, 1e-15);
+  EXPECT_TRUE(t.reproduces_scored_run); // the forces (zero) are the scored run's
+  EXPECT_THROW(time_model_runs(run, 0), std::invalid_argument);
+}
+
+TEST(CostTiming, ModelsAreTimedInTurn) {
+  // Two models, three rounds: the calls go A, B, A, B, A, B (a slow spell of the machine falls on
+  // one run of each, not on every run of one), and each model's summary is the one
+  // time_model_runs gives for its own runs. Model A's second run is slow throughout (a spell):
+  // its median over the runs leaves it out.
+  std::vector<std::string> calls;
+  const auto profile = [](double cost) {
+    ForceProfile p;
+    for (int k = 0; k < 100; ++k) {
+      ProfileRow row;
+      row.tool = "blade";
+      row.t = k * 1e-3;
+      row.cost_s = cost;
+      p.rows.push_back(row);
+    }
+    return p;
+  };
+  int a_runs = 0;
+  const std::vector<TimedModel> models{
+      {[&] {
+         calls.push_back("A");
+         return profile(++a_runs == 2 ? 90e-6 : 2e-6);
+       },
+       nullptr},
+      {[&] {
+         calls.push_back("B");
+         return profile(7e-6);
+       },
+       nullptr}};
+  std::vector<int> rounds;
+  const std::vector<TimedCost> t = time_models_in_turn(models, 3, [&](int round, double seconds) {
+    rounds.push_back(round);
+    EXPECT_GE(seconds, 0.0);
+  });
+  EXPECT_EQ(calls, (std::vector<std::string>{"A", "B", "A", "B", "A", "B"}));
+  EXPECT_EQ(rounds, (std::vector<int>{1, 2, 3}));
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t[0].runs, 3);
+  EXPECT_DOUBLE_EQ(t[0].p99, 2e-6);
+  EXPECT_DOUBLE_EQ(t[0].p99_high, 90e-6);
+  EXPECT_DOUBLE_EQ(t[1].p99, 7e-6);
+  EXPECT_DOUBLE_EQ(t[1].p99_spread(), 0.0);
+  EXPECT_THROW(time_models_in_turn(models, 0), std::invalid_argument);
+}
+
+TEST(CostTiming, AShortTrajectoryIsPassedAgainWithinARun) {
+  // A run passes at least timing_min_steps (5000) steps: ⌈5000 / steps⌉ passes — the sponge knife
+  // cut's 1341 steps 4 passes, clay_pull's 2601 two, a potato cut's 22 501 one.
+  EXPECT_EQ(timing_min_steps, 5000u);
+  EXPECT_EQ(passes_per_timed_run(1341), 4);
+  EXPECT_EQ(passes_per_timed_run(2601), 2);
+  EXPECT_EQ(passes_per_timed_run(5000), 1);
+  EXPECT_EQ(passes_per_timed_run(22501), 1);
+  // Three passes of 100 steps pool into one run of 300: pass p costs (p + 1) µs per step except
+  // its first step, 40 µs. Pooled, the 3 slow steps are the 3 largest of 300, so the nearest-rank
+  // p99 (index round(0.99 × 299) = 296 of the sorted 300) is the 297th smallest: a 3 µs step; a
+  // pass alone would give its 1 slow step at index 98 of 100 → its own (p + 1) µs.
+  int pass = 0;
+  const TimedModel model{[&] {
+                           ForceProfile p;
+                           const double c = (pass % 3 + 1) * 1e-6;
+                           for (int k = 0; k < 100; ++k) {
+                             ProfileRow row;
+                             row.tool = "blade";
+                             row.t = k * 1e-3;
+                             row.cost_s = k == 0 ? 40e-6 : c;
+                             p.rows.push_back(row);
+                           }
+                           ++pass;
+                           return p;
+                         },
+                         nullptr, 3};
+  const std::vector<TimedCost> t = time_models_in_turn({model}, 2);
+  EXPECT_EQ(pass, 6); // 2 runs × 3 passes
+  EXPECT_EQ(t[0].steps, 300u);
+  EXPECT_DOUBLE_EQ(t[0].p99, 3e-6);
+  EXPECT_DOUBLE_EQ(t[0].median, 2e-6);
+  EXPECT_DOUBLE_EQ(t[0].max, 40e-6);
+}
+
+TEST(StudyRunner, TheCostColumnsComeFromATimingPassOfTheirOwn) {
+  // A study without a reference (costs only): the fracture model on potato_rect_cut, timed three
+  // times after its scored run. Its row carries the timing pass's statistics, every timed run
+  // reproduced the scored forces (the model does not depend on the clock), and the table's caption
+  // says how the costs were measured.
+  const StudySpec spec = read_study(write_study("timing.toml", "[study]\nname = \"timing\"\nscenes = [\"potato_rect_cut\"]\n"
+                                                               "models = [\"fracture\"]\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_timing_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  StudyExecution execution;
+  execution.timing_runs = 3;
+  const StudyResult r = run_study(spec, out, {}, execution);
+  ASSERT_EQ(r.rows.size(), 1u);
+  ASSERT_TRUE(r.rows[0].timed.has_value());
+  const TimedCost& t = *r.rows[0].timed;
+  EXPECT_EQ(t.runs, 3);
+  EXPECT_EQ(t.steps, r.rows[0].cost.steps); // every step of the trajectory, as in the scored run
+  EXPECT_TRUE(t.reproduces_scored_run);
+  EXPECT_LE(t.p99_low, t.p99);
+  EXPECT_LE(t.p99, t.p99_high);
+  EXPECT_EQ(r.timing_runs, 3);
+  EXPECT_NE(r.table().markdown().find("each model timed alone after every other run of the study, the models in turn (3 runs each"), std::string::npos);
+  fs::remove_all(out);
+}
+
+TEST(StudyRunner, TheFinestLevelAtHalfTheIncrementGivesTheSamplingUncertainty) {
+  // The stand-in reference is the fracture model's profile at the solved samples; at half the load
+  // increment it is offset by 10 mN along x at every sample. The half-increment run solves 2N − 1
+  // samples, the N of the first among them: the sampling uncertainty — the time-weighted RMS of the
+  // two profiles' difference at their common times — is 10 mN exactly, the half-increment row's
+  // RMS error 10 mN over the peak, and with one mesh level (no GCI) the reference's uncertainty is
+  // that alone.
+  const StudySpec spec = read_study(write_study("time.toml", "[study]\nname = \"time\"\nscenes = [\"potato_rect_cut\"]\n"
+                                                             "models = [\"fracture\"]\n[reference]\nrefinements = [0]\nsamples = 8\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_time_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  std::atomic<int> solves{0};
+  const ReferenceRunner truth = fracture_as_reference(solves, 300.0);
+  std::vector<std::size_t> whole, half;
+  const ReferenceRunner offset = [&](const StudyReferenceSolve& solve, const StudyReferenceSpec& settings) -> ReferenceResult {
+    ForceProfile p = truth(solve, settings).profile;
+    if (solve.increment == LoadIncrement::half) {
+      half = solve.indices;
+      for (ProfileRow& row : p.rows) row.force.x() += 0.01;
+    } else {
+      whole = solve.indices;
+    }
+    return p;
+  };
+  StudyExecution execution;
+  execution.timing_runs = 1;
+  const StudyResult r = run_study(spec, out, offset, execution);
+  EXPECT_EQ(r.reference_runs, 2);
+  ASSERT_EQ(whole.size(), 8u);
+  ASSERT_EQ(half.size(), 15u);
+  EXPECT_TRUE(std::includes(half.begin(), half.end(), whole.begin(), whole.end()));
+  ASSERT_EQ(r.references.size(), 1u);
+  ASSERT_TRUE(r.references[0].sampling.has_value());
+  const SamplingVerification& v = *r.references[0].sampling;
+  EXPECT_EQ(v.samples, 8u);
+  EXPECT_NEAR(v.rms_difference, 0.01, 1e-12);
+  // The uncertainty is the larger of that and the shift of the time-averaged RMS |F| between the
+  // runs (the 15 samples weigh the fracture profile's time otherwise than the 8).
+  EXPECT_GT(v.rms_shift, 0.0);
+  ASSERT_TRUE(r.references[0].uncertainty().has_value());
+  EXPECT_DOUBLE_EQ(*r.references[0].uncertainty(), std::max(0.01, v.rms_shift));
+  EXPECT_NEAR(v.uncertainty(), std::max(v.rms_difference, v.rms_shift), 1e-15);
+  EXPECT_NE(r.rows[0].note.find("sampling uncertainty"), std::string::npos) << r.rows[0].note;
+  ASSERT_GE(r.rows.size(), 3u);
+  EXPECT_EQ(r.rows[1].model, "reference L0 (half increment)");
+  ASSERT_TRUE(r.rows[1].metrics.has_value()) << r.rows[1].note;
+  EXPECT_NEAR(r.rows[1].metrics->normalised_rms_force_error * r.rows[1].metrics->reference_peak_force, 0.01, 1e-12);
+  EXPECT_EQ(r.rows[2].model, "fracture");
+  // The model is the reference itself: its error (zero) is below the reference's uncertainty.
+  EXPECT_TRUE(r.rows[2].rms_below_reference_uncertainty);
+  // Per phase: a table with the fracture row, its error zero in every phase (no dominant phase).
+  const std::string phases = r.phase_table().markdown();
+  EXPECT_NE(phases.find("| potato_rect_cut | fracture |"), std::string::npos) << phases;
+  fs::remove_all(out);
+}
+
+} // namespace
+} // namespace kerf
+
+namespace kerf {
+namespace {
+
+TEST(StudyRunner, TheTableIsBuiltFromTheResultsInMemoryNotFromTheRecords) {
+  // The runs' records cannot be written: the scene's folder under the study's output is a file
+  // (which no process can make a folder of, root included). The reference cache is writable (the
+  // cache is the cache); every model run records nothing. The table is built from the results in
+  // memory all the same: the fracture row is scored (the stand-in reference is the model itself:
+  // zero error) and timed, and its note says its record was not written.
+  const StudySpec spec = read_study(write_study("memory.toml", "[study]\nname = \"memory\"\nscenes = [\"potato_rect_cut\"]\n"
+                                                               "models = [\"fracture\"]\n[reference]\nrefinements = [0]\nsamples = 8\n"
+                                                               "time_verification = false\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_memory_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  fs::create_directories(out);
+  std::ofstream(out / "potato_rect_cut") << "not a folder\n";
+  std::atomic<int> solves{0};
+  StudyExecution execution;
+  execution.timing_runs = 2;
+  const StudyResult r = run_study(spec, out, fracture_as_reference(solves, 300.0), execution);
+  ASSERT_EQ(r.rows.size(), 2u);
+  EXPECT_EQ(r.rows[0].model, "reference L0");
+  const StudyRow& model = r.rows[1];
+  EXPECT_EQ(model.model, "fracture");
+  ASSERT_TRUE(model.metrics.has_value()) << model.note;
+  EXPECT_NEAR(model.metrics->normalised_rms_force_error, 0.0, 1e-12);
+  ASSERT_TRUE(model.timed.has_value());
+  EXPECT_EQ(model.timed->runs, 2);
+  EXPECT_NE(model.note.find("its record was not written"), std::string::npos) << model.note;
+  EXPECT_TRUE(model.profile.empty());
+  EXPECT_FALSE(fs::is_directory(out / "potato_rect_cut"));
+  fs::remove_all(out);
+}
+
+} // namespace
+} // namespace kerf

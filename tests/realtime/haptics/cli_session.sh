@@ -45,14 +45,19 @@ paste -d, <(tail -n +4 session.csv | cut -d, -f15-17,21) <(tail -n +2 offline/pr
 echo "1. session matches the offline run ($(tail -n +4 session.csv | wc -l) ticks)"
 
 # 1b. the same session through the finite-element reference: its tool path is the recorded one
-# (one row per session tick in the replayed trajectory), solved at 3 evenly spaced samples
-# (3 samples and no more: adaptive sampling off; the body deforms only: fracture off, which a cutting
-# scene has on by default and which is not what this step checks.)
-"$KERF" reference "$SCENE" --trajectory session.csv --samples 3 --adaptive 0 --fracture off --no-fields -o replayed > reference.log 2>&1 ||
-  { cat reference.log; exit 1; }
+# (one row per session tick in the replayed trajectory), its load path through the hand's turns
+# (every vertex of the recorded motion beyond 10 µm) besides 3 evenly spaced output samples, over
+# the first 0.6 s — the approach and the first millimetres of the cut — with adaptive sampling off
+# and the body deforming only (fracture off, which a cutting scene has on by default and which is
+# not what this step checks; pressed uncut to the cut's full depth the razor would stop the path).
+"$KERF" reference "$SCENE" --trajectory session.csv --samples 3 --until 0.6 --vertex-tolerance 0.01 --adaptive 0 --fracture off \
+  --no-fields -o replayed > reference.log 2>&1 || { cat reference.log; exit 1; }
 [ "$(tail -n +2 replayed/session_blade.csv | wc -l)" -eq "$(tail -n +4 session.csv | wc -l)" ] ||
   { echo "the replayed trajectory does not have one row per session tick"; exit 1; }
-[ "$(tail -n +2 replayed/profile.csv | wc -l)" -eq 3 ] || { echo "expected 3 reference samples"; exit 1; }
+planned=$(sed -n 's/.*"loads_planned": *\([0-9]*\).*/\1/p' replayed/manifest.json | head -1)
+rows=$(tail -n +2 replayed/profile.csv | wc -l)
+[ -n "$planned" ] && [ "$rows" -eq "$planned" ] && [ "$rows" -ge 3 ] ||
+  { echo "expected every planned load (the 3 samples and the hand's turns: ${planned:-?}) in the profile, got $rows rows"; exit 1; }
 echo "1b. kerf reference --trajectory replays the session"
 
 # 2. SIGKILL the device mid-session

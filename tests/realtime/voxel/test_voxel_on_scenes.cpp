@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -58,10 +59,10 @@ TEST(VoxelOnScenes, TableOneIsReadInThePapersMillimetreUnit) {
   const Scene scene = read_scene(scene_file("sponge_cut_constant"));
   const SceneRun r = run(scene);
   // docs/models.md (voxel): "20.0 N/m^2" -> E = 20 N/mm^2 = 2e7 Pa, k_e = E x 1 mm = 2e4 N/m;
-  // "0.5 N s/m^2" -> b = 0.5 N s/mm = 500 N s/m.
+  // "0.5 N s/m^2" -> λ = 0.5 N s/mm^2 = 5e5 N s/m^2, per unit penetration (F = λ δ dδ/dt).
   EXPECT_DOUBLE_EQ(r.built.parameters["contact_stiffness_N_per_m"].get<double>(), 2e4);
   EXPECT_DOUBLE_EQ(r.built.parameters["clip_modulus_Pa"].get<double>(), 2e7);
-  EXPECT_DOUBLE_EQ(r.built.parameters["damping_N_s_per_m"].get<double>(), 500.0);
+  EXPECT_DOUBLE_EQ(r.built.parameters["damping_N_s_per_m2"].get<double>(), 5e5);
   EXPECT_TRUE(r.built.parameters["depth_cutting_stiffness"].get<bool>());
   EXPECT_TRUE(r.built.parameters["clip_friction"].get<bool>());
 }
@@ -174,4 +175,43 @@ TEST(VoxelOnScenes, RefusesScenesWithoutTableOneOrWithMoreThanOneTool) {
   }
   // clay_pull: one sphere, but no [models.voxel] (and no cutting).
   EXPECT_THROW(require_model_for_scene("voxel", read_scene(scene_file("clay_pull"))), ModelMismatch);
+}
+
+TEST(VoxelOnScenes, KnifeCutForceStepsAreTheOnesThePapersEquationsAllow) {
+  // sponge_knife_cut_proportional, the cut segment (the knife drawn down and along at 1 mm/s,
+  // the stick in contact): between two samples the force may change by
+  //  - smoothly, one sample's motion (|v| = 1 mm/s, Δt = 1 ms, so 1 µm of travel): the
+  //    elastic depth force by k_e |v| Δt = 0.02 N, the wall force by as much, the DCS 0.066 k_e d
+  //    by 0.066 k_e |v| Δt = 0.0013 N, the damping λ δ dδ/dt by λ δ_max |v|² Δt... (δ_max below,
+  //    < 10⁻⁵ N), CFF (Eq. 1, decreasing in Cl, growing with dz) by less than the DCS;
+  //  - at a depth advance (§2.3 step 3: the surface point moves one advance length h when
+  //    k_e δ_d exceeds F_crit,d): the normal force falls by at most what it was, k_e δ_max +
+  //    λ δ_max |v| with k_e δ_max ≤ F_crit,d + k_e |v| Δt (the first sample past the critical
+  //    force), and the Coulomb friction μ F_n with it, at right angles: sqrt(1 + μ²) ΔF_n;
+  //  - at a cutting advance: the wall force k_e δ_c, at most F_crit,c + k_e |v| Δt, drops to 0.
+  // A sample may hold both advances. The bound is their sum plus the smooth changes (the modes
+  // stay "cutting" through the segment, so DCS and CFF are not switched). With Table 1: k_e =
+  // 2e4 N/m, F_crit,d = 0.3 N, F_crit,c = 0.1 N, μ = 0.8, λ = 5e5 N s/m².
+  const SceneRun r = run(read_scene(scene_file("sponge_knife_cut_proportional")));
+  const double ke = 2e4, lambda = 5e5, mu = 0.8, v = 1e-3, dt = 1e-3;
+  const double smooth = ke * v * dt;
+  const double delta_max = (0.3 + smooth) / ke;
+  const double normal_drop = ke * delta_max + lambda * delta_max * v;
+  const double bound = std::sqrt(1.0 + mu * mu) * normal_drop + (0.1 + smooth) + 4.0 * smooth;
+  // The cut segment: from the approach's end (the point on the top face, t = 0.1 s) to the
+  // cut's end (t = 0.1 + 0.64 s), rows in contact on both sides.
+  double largest = 0.0;
+  int steps = 0;
+  const auto& rows = r.profile.rows;
+  for (std::size_t k = 1; k < rows.size(); ++k) {
+    if (rows[k].t <= 0.1 || rows[k].t > 0.74 || rows[k - 1].mode == InteractionMode::no_contact ||
+        rows[k].mode == InteractionMode::no_contact)
+      continue;
+    largest = std::max(largest, (rows[k].force - rows[k - 1].force).norm());
+    ++steps;
+  }
+  EXPECT_GT(steps, 500);
+  EXPECT_LE(largest, bound);
+  // and the advances do happen: the bound is not met by a force that never moves.
+  EXPECT_GT(largest, 0.5 * 0.3);
 }
