@@ -183,10 +183,7 @@ void DiscreteEdgeCuttingModel::step(std::span<const ToolState> tools, double /*d
   out = ForceSample{};
   const Eigen::Vector3d c = tools[0].position;
   const Eigen::Vector3d v = tools[0].velocity.allFinite() ? tools[0].velocity : Eigen::Vector3d::Zero();
-  if (!c.allFinite()) { // a broken input never becomes a force
-    ++m_non_finite;
-    return;
-  }
+  if (!finite_input(c, m_non_finite)) return;
   Eigen::Vector3d total = Eigen::Vector3d::Zero();
   bool any_cutting = false, any_fresh = false, any_in_cut = false;
   double crack_extent = 0.0;
@@ -224,16 +221,11 @@ void DiscreteEdgeCuttingModel::step(std::span<const ToolState> tools, double /*d
     record_pass(c, any_contact, any_cutting ? cut_points : 0, entry, front, inward);
   }
 
-  if (!total.allFinite()) {
-    ++m_non_finite;
-    total.setZero();
-  }
-  out.force = total;
-  out.mode = any_cutting ? InteractionMode::cutting
-             : any_fresh ? InteractionMode::deformation_1
-             : any_in_cut ? InteractionMode::deformation_2
-                          : InteractionMode::no_contact;
-  out.crack_extent = crack_extent;
+  const InteractionMode mode = any_cutting ? InteractionMode::cutting
+                              : any_fresh ? InteractionMode::deformation_1
+                              : any_in_cut ? InteractionMode::deformation_2
+                                           : InteractionMode::no_contact;
+  write_sample(out, total, mode, crack_extent, m_non_finite);
 }
 
 } // namespace kerf

@@ -120,10 +120,7 @@ void FractureCuttingModel::step(std::span<const ToolState> tools, double /*dt*/,
   ForceSample& out = forces[0];
   out = ForceSample{};
   const Eigen::Vector3d p = tools[0].position;
-  if (!p.allFinite()) { // a broken input never becomes a force
-    ++m_non_finite;
-    return;
-  }
+  if (!finite_input(p, m_non_finite)) return;
   const Eigen::Vector3d& e_x = m_setup.blade.cutting_direction;
   const Eigen::Vector3d& e_y = m_lateral_direction;
   const Eigen::Vector3d motion = m_have_previous ? Eigen::Vector3d(p - m_previous_position) : Eigen::Vector3d::Zero();
@@ -210,14 +207,7 @@ void FractureCuttingModel::step(std::span<const ToolState> tools, double /*dt*/,
     if (m_friction_x) fx -= m_friction_x->update(motion.dot(e_x), std::abs(fy), mu);
   }
 
-  Eigen::Vector3d force = -fx * e_x + fy * e_y;
-  if (!force.allFinite()) {
-    ++m_non_finite;
-    force.setZero();
-  }
-  out.force = force;
-  out.mode = mode;
-  out.crack_extent = m_crack_extent;
+  write_sample(out, -fx * e_x + fy * e_y, mode, m_crack_extent, m_non_finite);
 }
 
 } // namespace kerf

@@ -200,10 +200,7 @@ void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*d
   const Eigen::Vector3d velocity = tools[0].velocity.allFinite() ? tools[0].velocity : Eigen::Vector3d::Zero();
   out.crack_extent = m_cut_length;
   m_last_depth_force = m_last_cutting_force = 0.0;
-  if (!p.allFinite()) { // a broken input never becomes a force
-    ++m_non_finite;
-    return;
-  }
+  if (!finite_input(p, m_non_finite)) return;
 
   // Contact with the body as built: starts an episode (and its grid), or ends one.
   const SurfaceQuery::Closest closest = m_query.closest_point(p);
@@ -262,13 +259,7 @@ void VoxelSurfaceCuttingModel::step(std::span<const ToolState> tools, double /*d
       force += clip_friction_force(s.friction_coefficient, s.clip_modulus, r, tip.x(), m_cut_length) * resist;
     }
   }
-  if (!force.allFinite()) {
-    ++m_non_finite;
-    force.setZero();
-  }
-  out.force = force;
-  out.mode = mode;
-  out.crack_extent = m_cut_length;
+  write_sample(out, force, mode, m_cut_length, m_non_finite);
 }
 
 } // namespace kerf
