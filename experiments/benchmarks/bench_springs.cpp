@@ -17,6 +17,7 @@
 #include "realtime/springs/network_system.hpp"
 #include "realtime/springs/symplectic_euler.hpp"
 #include "realtime/springs/spring_network_model.hpp"
+#include "tests/realtime/springs/model_fixtures.hpp"
 
 #include <benchmark/benchmark.h>
 
@@ -157,7 +158,7 @@ double thread_seconds() {
 }
 
 /// A tear storm: clay_tear (experiments/scenes/clay_tear.toml) on a 24 x 8 x 8 box mesh of the
-/// 60 x 20 x 20 mm bar, as tests/realtime/springs/test_tearing.cpp sets it up (12 cells per side,
+/// 60 x 20 x 20 mm bar, test::clay_tear_setup (tests/realtime/springs/model_fixtures.hpp; 12 cells along it,
 /// h = 5 mm, styluses grasping the nodes within 7.5 mm, pulled apart at 5 mm/s each, tensile
 /// limit 50 kPa), 1 ms samples until 50 samples past the rupture (the vertex splits come one per
 /// sample, many in consecutive samples). Each sample's CPU time is taken alone; counters: the
@@ -165,19 +166,8 @@ double thread_seconds() {
 /// that split a vertex and of the sample after one (where the implicit and quasi-static
 /// integrators refactorise on the kept tear-ready pattern), and the samples over 1 ms.
 void tear_storm(benchmark::State& state, SpringIntegrator integrator) {
-  const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.06, 0.01, 0.02}, 24, 8, 8);
-  SpringNetworkSetup s;
-  s.youngs_modulus = 0.5e6;
-  s.poisson_ratio = 0.45;
-  s.density = 1700.0;
-  s.damping = 10.0;
-  s.integrator = integrator;
-  s.supports = {{"support", true}};
-  s.styluses = {{Eigen::Vector3d(0.015, 0.0, 0.022), 0.002}, {Eigen::Vector3d(0.045, 0.0, 0.022), 0.002}};
-  s.cells = 12;
-  s.grasp_radius = 0.0075;
-  s.tearing = true;
-  s.tensile_limit = 50e3;
+  const TetMesh mesh = test::clay_tear_mesh();
+  SpringNetworkSetup s = test::clay_tear_setup(integrator);
   SpringNetworkModel model(mesh, s);
   std::vector<double> cost, wall, tearing, after;
   cost.reserve(2200);

@@ -194,14 +194,8 @@ TEST(SpringsAdapter, FineMeshFollowsTheNetworkInsideAndRestsOutside) {
 TEST(SpringsAdapter, TornBodyMovesWithItsPieces) {
   const Scene scene = read_scene(std::string(KERF_SCENES_DIR) + "/clay_tear.toml");
   const TetMesh mesh = scene_mesh(scene);
-  SpringNetworkSetup s = test::clay_pull_setup(SpringIntegrator::implicit_euler);
-  s.supports = {{"support", true}};
-  s.styluses = {{Eigen::Vector3d(0.015, 0.0, 0.022), 0.002}, {Eigen::Vector3d(0.045, 0.0, 0.022), 0.002}};
-  s.cells = 12;
+  SpringNetworkSetup s = test::clay_tear_setup(SpringIntegrator::implicit_euler);
   s.cell_size = 0.005;
-  s.grasp_radius = 0.0075;
-  s.tearing = true;
-  s.tensile_limit = 50e3;
   SpringNetworkModel model(mesh, s);
   std::unique_ptr<ModelAdapter> adapter = make_model_adapter(model, mesh);
   ViewedModel viewed(model, *adapter, 1.0);

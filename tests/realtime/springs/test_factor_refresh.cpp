@@ -64,19 +64,8 @@ struct TearRun {
 };
 
 TearRun tear_run(FactorRefreshPolicy policy, int samples) {
-  const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.06, 0.01, 0.02}, 24, 8, 8);
-  SpringNetworkSetup s;
-  s.youngs_modulus = 0.5e6;
-  s.poisson_ratio = 0.45;
-  s.density = 1700.0;
-  s.damping = 10.0;
-  s.integrator = SpringIntegrator::implicit_euler;
-  s.supports = {{"support", true}};
-  s.styluses = {{Eigen::Vector3d(0.015, 0.0, 0.022), 0.002}, {Eigen::Vector3d(0.045, 0.0, 0.022), 0.002}};
-  s.cells = 12;
-  s.grasp_radius = 0.0075;
-  s.tearing = true;
-  s.tensile_limit = 50e3;
+  const TetMesh mesh = test::clay_tear_mesh();
+  SpringNetworkSetup s = test::clay_tear_setup(SpringIntegrator::implicit_euler);
   s.refresh = policy;
   SpringNetworkModel model(mesh, s);
   TearRun run;

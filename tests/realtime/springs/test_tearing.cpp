@@ -62,14 +62,8 @@ TEST(Tearing, ClayTearSplitsIntoTwoPiecesThatKeepTheVolume) {
   // base), styluses at x = 15 and 45 mm on the top face grasping the nodes within 7.5 mm, pulled
   // apart at 5 mm/s each; the network (12 cells per side, h = 5 mm) tears at the cohesive
   // strength 50 kPa, stepped by implicit Euler.
-  const TetMesh mesh = box_tet_mesh({0.0, -0.01, 0.0}, {0.06, 0.01, 0.02}, 24, 8, 8);
-  SpringNetworkSetup s = test::clay_pull_setup(SpringIntegrator::implicit_euler);
-  s.supports = {{"support", true}};
-  s.styluses = {{Eigen::Vector3d(0.015, 0.0, 0.022), 0.002}, {Eigen::Vector3d(0.045, 0.0, 0.022), 0.002}};
-  s.cells = 12;
-  s.grasp_radius = 0.0075;
-  s.tearing = true;
-  s.tensile_limit = 50e3;
+  const TetMesh mesh = test::clay_tear_mesh();
+  const SpringNetworkSetup s = test::clay_tear_setup(SpringIntegrator::implicit_euler);
   SpringNetworkModel model(mesh, s);
   ASSERT_NEAR(model.network().block.cell_size, 0.005, 1e-15);
   std::array<ToolState, 2> tools;
