@@ -16,9 +16,9 @@ struct ForceSample {
   bool over_budget = false;   ///< the model could not finish within its time budget
 };
 
-/// The guard at both ends of a fast model's step: a broken input or a non-finite force never
-/// becomes a force on the device (DESIGN.md: a model never returns NaN). Each guard that trips
-/// counts once in `non_finite`, which the models report as non_finite_count() (should stay 0).
+// The guard at both ends of a fast model's step: a broken input or a non-finite force never
+// becomes a force on the device (DESIGN.md: a model never returns NaN). Each guard that trips
+// counts once in `non_finite`, which the models report as non_finite_count() (should stay 0).
 
 /// True when the tool's position is usable; otherwise counts it and leaves `out` as it is (the
 /// caller returns it: zero force, no contact).

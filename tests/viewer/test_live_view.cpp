@@ -49,6 +49,7 @@ std::filesystem::path trajectory_csv(const SampledTrajectory& t, const std::stri
 }
 
 constexpr double servo_rate = 1000.0; ///< [Hz] every session's servo loop
+constexpr double session_seconds = 1.5; ///< [s] each session's length (LiveViewSettings::servo.duration)
 
 /// A sanitizer build (GCC's -fsanitize=address defines __SANITIZE_ADDRESS__): every session's
 /// memory is checked, but its deadline counts do not judge the view (expect_no_overrun).
@@ -57,7 +58,6 @@ constexpr bool sanitizer_build = true;
 #else
 constexpr bool sanitizer_build = false;
 #endif
-constexpr double session_seconds = 1.5; ///< [s] each session's length (LiveViewSettings::servo.duration)
 
 /// One session of `duration` s: a fresh model and replay device(s), the view on or off.
 LiveViewReport session(const std::string& scene_name, const std::string& model_name, double model_rate, bool view) {
