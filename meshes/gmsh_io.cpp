@@ -78,10 +78,34 @@ public:
   GmshSession(const GmshSession&) = delete;
   GmshSession& operator=(const GmshSession&) = delete;
 
-  /// Empty model and ONELAB database (stale ONELAB values would override a .geo's defaults).
+  /// Empty model and ONELAB database (stale ONELAB values would override a .geo's defaults), and
+  /// the meshing options back at gmsh's defaults: gmsh::clear() empties the model but keeps the
+  /// options, and a .geo that grades its mesh with a size field turns Mesh.MeshSizeFromPoints and
+  /// Mesh.MeshSizeExtendFromBoundary off (meshes/geo/*.geo) — without this every later mesh of the
+  /// process was made without them, and a scene meshed differently after a graded one (the wedge's
+  /// 1 441 nodes became 1 363; test SceneMeshHistory).
   static void reset() {
     gmsh::clear();
     gmsh::onelab::clear();
+    for (const auto& [name, value] : default_mesh_options()) gmsh::option::setNumber(name, value);
+  }
+
+  /// The meshing options a .geo of meshes/geo or kerf's own code sets, with gmsh's values for them
+  /// when it was initialised.
+  static const std::vector<std::pair<std::string, double>>& default_mesh_options() {
+    static const std::vector<std::pair<std::string, double>> defaults = [] {
+      std::vector<std::pair<std::string, double>> d;
+      for (const char* name : {"Mesh.MeshSizeFromPoints", "Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromCurvature",
+                               "Mesh.MeshSizeMax", "Mesh.MeshSizeMin", "Mesh.MeshSizeFactor", "Mesh.ElementOrder", "Mesh.Optimize",
+                               "Mesh.OptimizeNetgen", "Mesh.Algorithm", "Mesh.Algorithm3D", "Mesh.RandomSeed", "Mesh.RandomFactor",
+                               "Mesh.MshFileVersion", "Mesh.Binary", "Mesh.SaveAll", "Mesh.SaveParametric"}) {
+        double value = 0.0;
+        gmsh::option::getNumber(name, value);
+        d.emplace_back(name, value);
+      }
+      return d;
+    }();
+    return defaults;
   }
 
   /// Runs `action`; throws MeshError("<file>: <what>: <gmsh errors>") if it throws or if gmsh

@@ -112,34 +112,55 @@ ProfilePlotReference write_reference_series(const SceneReference& reference, con
 
 } // namespace
 
-void write_study_report(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out) {
+namespace {
+
+/// The reference of `scene` in `result`, or nullptr.
+const SceneReference* reference_of(const StudyResult& result, const std::string& scene) {
+  const SceneReference* reference = nullptr;
+  for (const SceneReference& r : result.references)
+    if (r.scene == scene) reference = &r;
+  return reference;
+}
+
+} // namespace
+
+void write_profile_plots(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out) {
   namespace fs = std::filesystem;
-  result.table().write(out, "study");
-  result.phase_table().write(out, "study_phases");
-  if (!result.references.empty()) verification_table(result).write(out, "verification");
   for (const fs::path& scene_file : spec.scenes) {
     const Scene scene = read_scene(scene_file);
     std::vector<std::pair<std::string, fs::path>> runs;
-    bool any_error = false;
-    for (const StudyRow& r : result.rows) {
-      if (r.scene != scene.name) continue;
-      any_error = any_error || r.metrics.has_value();
-      if (!r.profile.empty() && r.model.rfind("reference", 0) != 0) runs.emplace_back(r.model, r.profile);
-    }
-    const SceneReference* reference = nullptr;
-    for (const SceneReference& r : result.references)
-      if (r.scene == scene.name) reference = &r;
+    for (const StudyRow& r : result.rows)
+      if (r.scene == scene.name && !r.profile.empty() && r.model.rfind("reference", 0) != 0) runs.emplace_back(r.model, r.profile);
+    const SceneReference* reference = reference_of(result, scene.name);
     if (runs.empty() && !reference) continue;
     const Eigen::Vector3d direction = advance_direction(scene);
     std::optional<ProfilePlotReference> drawn;
     if (reference) drawn = write_reference_series(*reference, direction, out / (scene.name + "_reference.csv"));
     plot_profiles(out / (scene.name + "_profiles"), runs, direction, drawn, holds_or_retreats(scene),
                   scene.name + ": resisting force of the " + scene.tools.front().name);
-    if (any_error)
-      plot_pareto(out / (scene.name + "_pareto"), out / "study.csv", "RMS force error [%]", "p99 cost [µs]", "model", scene.name,
-                  reference && rms_error_floor(*reference) ? std::optional<double>(100.0 * *rms_error_floor(*reference)) : std::nullopt,
-                  scene.name + ": RMS force error against cost");
   }
+}
+
+void write_tables_and_charts(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out) {
+  namespace fs = std::filesystem;
+  result.table().write(out, "study");
+  result.phase_table().write(out, "study_phases");
+  if (!result.references.empty()) verification_table(result).write(out, "verification");
+  for (const fs::path& scene_file : spec.scenes) {
+    const std::string scene = read_scene(scene_file).name;
+    const bool any_error = std::any_of(result.rows.begin(), result.rows.end(),
+                                       [&](const StudyRow& r) { return r.scene == scene && r.metrics.has_value(); });
+    if (!any_error) continue;
+    const SceneReference* reference = reference_of(result, scene);
+    plot_pareto(out / (scene + "_pareto"), out / "study.csv", "RMS force error [%]", "p99 cost [µs]", "model", scene,
+                reference && rms_error_floor(*reference) ? std::optional<double>(100.0 * *rms_error_floor(*reference)) : std::nullopt,
+                scene + ": RMS force error against cost");
+  }
+}
+
+void write_study_report(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out) {
+  write_tables_and_charts(spec, result, out);
+  write_profile_plots(spec, result, out);
 }
 
 } // namespace kerf

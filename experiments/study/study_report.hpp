@@ -24,9 +24,17 @@ StudyTable verification_table(const StudyResult& result);
 /// the finest level's peak |F| [N]; empty without either verification.
 std::optional<double> rms_error_floor(const SceneReference& reference);
 
-/// Writes the tables and the plots of `result` into `out` (study.*, verification.*, and per scene of
-/// `spec` SCENE_reference.csv, SCENE_profiles.*, SCENE_pareto.*). Throws std::runtime_error if a
-/// plot cannot be drawn.
+/// Per scene of `spec`, the force profiles of `result` into `out`: SCENE_reference.csv (the finest
+/// reference with its band) and SCENE_profiles.* (the reference, every model on top). They need the
+/// scored runs only, not their costs. Throws std::runtime_error if a plot cannot be drawn.
+void write_profile_plots(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out);
+
+/// The tables of `result` (study.*, study_phases.*, verification.*) and per scene of `spec` the
+/// speed/accuracy chart SCENE_pareto.* into `out`. Throws std::runtime_error if a chart cannot be
+/// drawn.
+void write_tables_and_charts(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out);
+
+/// Both: every table and plot of `result` into `out`.
 void write_study_report(const StudySpec& spec, const StudyResult& result, const std::filesystem::path& out);
 
 } // namespace kerf

@@ -635,8 +635,13 @@ StudyResult StudyRun::run() {
   result.fit_seconds = seconds_since(fits_started);
   if (m_execution.rank != 0) return result;
 
-  // Rank 0 alone: the timing pass, then the tables.
+  // Rank 0 alone: the accuracy (known now), the timing pass, then the tables.
   collect_runs();
+  if (m_execution.scored) {
+    StudyResult scored = result; // the costs as the scored runs measured them
+    for (std::size_t s = 0; s < m_plan.scenes.size(); ++s) scene_rows(s, scored);
+    m_execution.scored(scored);
+  }
   const auto timing_started = std::chrono::steady_clock::now();
   time_models();
   result.timing_seconds = seconds_since(timing_started);
@@ -814,23 +819,42 @@ StudyResult run_study(const StudySpec& spec, const std::filesystem::path& out, c
   return StudyRun(spec, out, reference, execution).run();
 }
 
-StudyTable StudyResult::table() const {
-  StudyTable t({{"scene", "", 3, 1.0},
+namespace {
+
+/// The study table, with its cost columns or without them.
+StudyTable study_table(const StudyResult& result, bool costs);
+
+} // namespace
+
+StudyTable StudyResult::table() const { return study_table(*this, true); }
+
+StudyTable StudyResult::accuracy_table() const { return study_table(*this, false); }
+
+namespace {
+
+StudyTable study_table(const StudyResult& result, bool costs) {
+  std::vector<StudyTable::Column> columns{{"scene", "", 3, 1.0},
                 {"model", "", 3, 1.0},
                 {"RMS force error", "%", 3, 100.0},
                 {"peak force error", "%", 3, 100.0},
                 {"rupture travel error", "mm", 3, 1e3},
                 {"steady cutting error", "%", 3, 100.0},
                 {"work error", "%", 3, 100.0},
-                {"mode agreement", "%", 3, 100.0},
-                {"median cost", "µs", 3, 1e6},
-                {"p99 cost", "µs", 3, 1e6},
-                {"p99 cost spread", "%", 2, 100.0},
-                {"max cost", "µs", 3, 1e6},
-                {"rate allowed", "kHz", 3, 1e-3},
-                {"note", "", 3, 1.0}});
+                {"mode agreement", "%", 3, 100.0}};
+  if (costs)
+    columns.insert(columns.end(), {{"median cost", "µs", 3, 1e6},
+                                   {"p99 cost", "µs", 3, 1e6},
+                                   {"p99 cost spread", "%", 2, 100.0},
+                                   {"max cost", "µs", 3, 1e6},
+                                   {"rate allowed", "kHz", 3, 1e-3}});
+  columns.push_back({"note", "", 3, 1.0});
+  StudyTable t(std::move(columns));
   t.group_by_first_column(true);
-  if (!machine.empty()) {
+  const std::string& machine = result.machine;
+  const int timing_runs = result.timing_runs, jobs = result.jobs, ranks = result.ranks;
+  if (!costs)
+    t.set_caption("Accuracy against the reference; the costs follow from the timing pass.");
+  else if (!machine.empty()) {
     if (timing_runs > 0)
       t.set_caption("Costs: wall time per servo step on " + machine + ", each model timed alone after every other run of the study, the models in turn (" +
                     std::to_string(timing_runs) + " runs each, a run at least " + std::to_string(timing_min_steps) +
@@ -842,7 +866,7 @@ StudyTable StudyResult::table() const {
                     (jobs * ranks > 1 ? " at once (a run beside others is slower)" : "") + ".");
   }
   using O = std::optional<double>;
-  for (const StudyRow& r : rows) {
+  for (const StudyRow& r : result.rows) {
     const bool m = r.metrics.has_value();
     using Cell = StudyTable::Cell;
     const Cell rms = r.rms_below_reference_uncertainty ? Cell{std::string(below_reference_uncertainty)}
@@ -855,11 +879,16 @@ StudyTable StudyResult::table() const {
     } else if (r.cost.steps > 0) {
       median = r.cost.median, p99 = r.cost.p99, max = r.cost.max, rate = r.cost.rate_allowed();
     }
-    t.add_row({r.scene, r.model, rms, peak, m ? r.metrics->rupture_displacement_error : O(), m ? r.metrics->steady_cutting_force_error : O(),
-               m ? O(r.metrics->work_error) : O(), m ? O(r.metrics->mode_agreement) : O(), median, p99, spread, max, rate, r.note});
+    std::vector<Cell> row{r.scene, r.model, rms, peak, m ? r.metrics->rupture_displacement_error : O(), m ? r.metrics->steady_cutting_force_error : O(),
+                          m ? O(r.metrics->work_error) : O(), m ? O(r.metrics->mode_agreement) : O()};
+    if (costs) row.insert(row.end(), {median, p99, spread, max, rate});
+    row.emplace_back(r.note);
+    t.add_row(std::move(row));
   }
   return t;
 }
+
+} // namespace
 
 StudyTable StudyResult::phase_table() const {
   const InteractionMode modes[] = {InteractionMode::no_contact, InteractionMode::deformation_1, InteractionMode::rupture,

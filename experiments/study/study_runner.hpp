@@ -81,6 +81,9 @@ struct StudyResult {
   /// The publishable table, rows grouped by scene, with a caption saying how the costs were
   /// measured and on which machine.
   StudyTable table() const;
+  /// The table's accuracy columns alone (scene, model, the errors, mode agreement, note): what
+  /// the study knows before its timing pass (StudyExecution::scored).
+  StudyTable accuracy_table() const;
   /// The force error per phase of the reference (profile_metrics.hpp) of every scored model row,
   /// and the phase with the largest share of the squared error.
   StudyTable phase_table() const;
@@ -119,6 +122,11 @@ struct StudyExecution {
   std::function<int(int value)> synchronise;
   /// Progress lines (study_progress.hpp) go here; nullptr: silent.
   std::FILE* progress = stderr;
+  /// Called on rank 0 once every run is scored and before the timing pass, with the rows as they
+  /// stand then: every error column final, the cost columns those of the scored runs (as they ran
+  /// beside others). The accuracy is known minutes before the costs: `kerf study` prints it and
+  /// draws the profile plots here. Empty: not called.
+  std::function<void(const StudyResult& scored)> scored;
 };
 
 /// `reference` may be empty (no reference built): then only costs are reported (and nothing is

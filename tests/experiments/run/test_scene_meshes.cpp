@@ -91,3 +91,29 @@ TEST_P(SceneMeshes, MatchTheirGeometry) {
 
 INSTANTIATE_TEST_SUITE_P(AllScenes, SceneMeshes, ::testing::ValuesIn(scene_names()),
                          [](const auto& info) { return info.param; });
+
+// A scene meshes the same whatever the process meshed before it: gmsh keeps its options from one
+// model to the next (gmsh::clear() empties the model, not the options), and a .geo that grades its
+// mesh with a size field turns Mesh.MeshSizeFromPoints and Mesh.MeshSizeExtendFromBoundary off. A
+// study meshes the scenes' reference and model meshes one after another in one process, so without
+// a reset a mesh depended on which scenes were meshed before it (a resumed study, whose first scene's
+// reference came from the cache, solved the second on another mesh). Expected: node for node equal.
+TEST(SceneMeshHistory, AMeshDoesNotDependOnTheMeshesBeforeIt) {
+  const fs::path scenes = fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes";
+  const Scene wedge = read_scene(scenes / "potato_wedge_cut.toml");
+  const Scene clay = read_scene(scenes / "clay_pull.toml");
+  for (const MeshPurpose purpose : {MeshPurpose::scene, MeshPurpose::reference}) {
+    SCOPED_TRACE(purpose == MeshPurpose::scene ? "scene mesh" : "reference mesh");
+    const TetMesh clay_first = scene_mesh(clay, purpose);
+    const TetMesh first = scene_mesh(wedge, purpose);
+    (void)scene_mesh(clay, MeshPurpose::reference); // a graded mesh in between
+    const TetMesh again = scene_mesh(wedge, purpose);
+    const TetMesh clay_again = scene_mesh(clay, purpose);
+    ASSERT_EQ(first.nodes.rows(), again.nodes.rows());
+    ASSERT_EQ(first.tets.rows(), again.tets.rows());
+    EXPECT_EQ(first.nodes, again.nodes);
+    EXPECT_EQ(first.tets, again.tets);
+    ASSERT_EQ(clay_first.nodes.rows(), clay_again.nodes.rows());
+    EXPECT_EQ(clay_first.nodes, clay_again.nodes);
+  }
+}

@@ -1013,6 +1013,49 @@ TEST(StudyRunner, TheCostColumnsComeFromATimingPassOfTheirOwn) {
   fs::remove_all(out);
 }
 
+TEST(StudyRunner, TheAccuracyIsReportedBeforeTheTimingPass) {
+  // StudyExecution::scored is called once, before the timing pass (no row timed yet), with every
+  // error the final table holds: the same metrics row by row, the accuracy table the study table
+  // without its five cost columns. The stand-in reference is the fracture model's own profile.
+  const StudySpec spec = read_study(write_study("scored.toml", "[study]\nname = \"scored\"\nscenes = [\"potato_rect_cut\"]\n"
+                                                               "models = [\"fracture\", \"edge\"]\n[reference]\nrefinements = [0]\nsamples = 8\n"
+                                                               "time_verification = false\n"));
+  const fs::path out = fs::temp_directory_path() / ("kerf_test_study_scored_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  std::atomic<int> solves{0};
+  StudyExecution execution;
+  execution.timing_runs = 1;
+  int calls = 0;
+  StudyResult scored;
+  execution.scored = [&](const StudyResult& s) {
+    ++calls;
+    scored = s;
+  };
+  const StudyResult r = run_study(spec, out, fracture_as_reference(solves, 300.0), execution);
+  EXPECT_EQ(calls, 1);
+  ASSERT_EQ(scored.rows.size(), r.rows.size());
+  int scored_models = 0;
+  for (std::size_t k = 0; k < r.rows.size(); ++k) {
+    SCOPED_TRACE(r.rows[k].model);
+    EXPECT_EQ(scored.rows[k].model, r.rows[k].model);
+    EXPECT_FALSE(scored.rows[k].timed.has_value()); // before the timing pass
+    ASSERT_EQ(scored.rows[k].metrics.has_value(), r.rows[k].metrics.has_value());
+    if (!r.rows[k].metrics) continue;
+    EXPECT_EQ(scored.rows[k].metrics->normalised_rms_force_error, r.rows[k].metrics->normalised_rms_force_error);
+    EXPECT_EQ(scored.rows[k].metrics->work_error, r.rows[k].metrics->work_error);
+    if (r.rows[k].model.rfind("reference", 0) != 0) {
+      EXPECT_TRUE(r.rows[k].timed.has_value());
+      ++scored_models;
+    }
+  }
+  EXPECT_EQ(scored_models, 2);
+  const StudyTable accuracy = scored.accuracy_table(), full = r.table();
+  EXPECT_EQ(accuracy.columns().size() + 5, full.columns().size());
+  EXPECT_EQ(accuracy.markdown().find("p99 cost"), std::string::npos);
+  EXPECT_EQ(accuracy.row_count(), full.row_count());
+  fs::remove_all(out);
+}
+
 TEST(StudyRunner, TheFinestLevelAtHalfTheIncrementGivesTheSamplingUncertainty) {
   // The stand-in reference is the fracture model's profile at the solved samples; at half the load
   // increment it is offset by 10 mN along x at every sample. The half-increment run solves 2N − 1
