@@ -297,7 +297,9 @@ struct FiniteStrainSolver::Impl {
   void make_grid(const TetMesh& mesh, const std::vector<int>& material);
   /// boundary_id = the face's class (its set of surface groups, `face_classes`).
   void set_boundary_ids(const TetMesh& mesh);
-  void distribute_grid();
+  /// Under mpirun with N > 1 processes: partitions `tria` (METIS on its cells' face graph, the
+  /// cohesive interface's face pairs joined into it) and builds this process's part.
+  void distribute_grid(const FiniteStrainProblem& problem);
   void setup_finite_element();
   /// Each DoF's support point (node-major: DoF 3k + c at node k); fills reference_coordinate.
   std::vector<dealii::Point<3>> support_points();
@@ -386,6 +388,10 @@ struct FiniteStrainSolver::Impl {
   /// Commits every point's history at the converged `state` (algebra.hpp's readable(): this
   /// process's pairs' DOFs) and returns the whole interface's summary (summed over the processes).
   CohesiveSummary commit_cohesive(const LoadState& load, const dealii::Vector<double>& state);
+  /// The (+ cell, − cell) active cell indices on `tria` of every face pair of the split crack path,
+  /// before any DOF exists (the partition joins them: distribute_grid).
+  std::vector<std::pair<unsigned, unsigned>> cohesive_cell_pairs(const CohesiveInterfaceSpec& spec, int plus_group,
+                                                                 int minus_group) const;
   /// Distributed: the pairs whose + cell this process owns, numbered as the serial build numbers them.
   void build_distributed_cohesive(const CohesiveInterfaceSpec& spec, int plus_group, int minus_group);
   /// Distributed: the Dirichlet DOFs among la.relevant as the whole mesh assigns them (each process

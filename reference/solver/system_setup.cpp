@@ -18,6 +18,7 @@
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/grid/tria_description.h>
 #include <deal.II/lac/dynamic_sparsity_pattern.h>
+#include <deal.II/lac/sparsity_pattern.h>
 #include <deal.II/lac/sparsity_tools.h>
 
 #include <Eigen/Geometry>
@@ -119,7 +120,7 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   make_grid(mesh, make_materials(problem));
   set_boundary_ids(mesh);
   if (settings.refinements > 0) tria.refine_global(static_cast<unsigned>(settings.refinements));
-  distribute_grid();
+  distribute_grid(problem);
   setup_finite_element();
   std::vector<dealii::Point<3>> support = support_points();
   make_dirichlet_dofs(problem, support);
@@ -219,7 +220,7 @@ void FiniteStrainSolver::Impl::set_boundary_ids(const TetMesh& mesh) {
     }
 }
 
-void FiniteStrainSolver::Impl::distribute_grid() {
+void FiniteStrainSolver::Impl::distribute_grid(const FiniteStrainProblem& problem) {
   // Under mpirun with N > 1 processes: METIS splits the (refined) mesh into N parts and each
   // process keeps its part plus a layer of ghost cells (deal.II's tests/simplex/step-40 way;
   // a fully distributed triangulation cannot be refined afterwards).
@@ -231,7 +232,25 @@ void FiniteStrainSolver::Impl::distribute_grid() {
   }
   if (!distributed) return;
   parallel = std::make_unique<DistributedAlgebra>();
-  dealii::GridTools::partition_triangulation(static_cast<unsigned>(process_count), tria);
+  if (problem.cohesive) {
+    // The mesh is split along the crack path (its two faces are copies): on the cells' face graph
+    // alone it is two bodies, and METIS cuts it there — where the crack-path grading puts most of
+    // the nodes, so that each process's rows reached over half of the other's DOFs through the
+    // cohesive pairs (docs/reference.md, "Strong scaling of the cut"). Joined by the pairs, the
+    // graph is the body the interface holds together, and the cut falls elsewhere.
+    dealii::DynamicSparsityPattern graph;
+    dealii::GridTools::get_face_connectivity_of_cells(tria, graph);
+    for (const auto& [plus, minus] : cohesive_cell_pairs(*problem.cohesive, surface_group(problem.cohesive->plus_surface, "cohesive"),
+                                                         surface_group(problem.cohesive->minus_surface, "cohesive"))) {
+      graph.add(plus, minus);
+      graph.add(minus, plus);
+    }
+    dealii::SparsityPattern cell_graph;
+    cell_graph.copy_from(graph);
+    dealii::GridTools::partition_triangulation(static_cast<unsigned>(process_count), cell_graph, tria);
+  } else {
+    dealii::GridTools::partition_triangulation(static_cast<unsigned>(process_count), tria);
+  }
   const auto description =
       dealii::TriangulationDescription::Utilities::create_description_from_triangulation(tria, parallel->comm);
   distributed_tria = std::make_unique<dealii::parallel::fullydistributed::Triangulation<3>>(parallel->comm);
