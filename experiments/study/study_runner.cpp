@@ -360,6 +360,10 @@ private:
   void time_models();
   void scene_rows(std::size_t s, StudyResult& result) const;
   std::optional<SceneReference> verify(std::size_t s, StudyResult& result) const;
+  std::string verify_in_time(const StudyPlannedScene& planned, SceneReference& verified, std::optional<ForceProfile>& half,
+                             StudyResult& result) const;
+  void coarser_reference_rows(const StudyPlannedScene& planned, const SceneReference& verified, const std::vector<ReferenceLevel>& levels,
+                              const std::optional<ForceProfile>& half, StudyResult& result) const;
   void model_rows(std::size_t s, const SceneReference* reference, StudyResult& result) const;
   StudyRow model_row(const StudyPlannedScene& scene, const std::string& label, const StudyModelRun& run, const RunOutcome& outcome,
                      const fs::path& dir, const SceneReference* reference) const;
@@ -703,24 +707,8 @@ std::optional<SceneReference> StudyRun::verify(std::size_t s, StudyResult& resul
     space = std::string("no GCI available: ") + e.what();
   }
   // In time: the finest level at half the load increment.
-  std::string time;
   std::optional<ForceProfile> half;
-  if (planned.time_check) {
-    const SolveOutcome& outcome = m_solves[*planned.time_check];
-    if (!outcome.stopped.empty())
-      result.stopped_references.push_back(scene.name + " " + level_name(m_plan.solves[*planned.time_check]) + ": " + outcome.stopped);
-    if (!outcome.profile) {
-      time = "no sampling uncertainty: the run at half the load increment failed (" + outcome.error + ")";
-    } else {
-      half = outcome.profile;
-      try {
-        verified.sampling = verify_sampling(finest, *half, tool);
-        time = verified.sampling->summary();
-      } catch (const std::exception& e) {
-        time = std::string("no sampling uncertainty: ") + e.what();
-      }
-    }
-  }
+  const std::string time = verify_in_time(planned, verified, half, result);
   char head[96];
   std::snprintf(head, sizeof head, "mesh h = %.3g mm; ", study_reference_element_size(scene, finest_solve.level) * 1e3);
   verified.note = stopped + resolution + failed + space + (time.empty() ? "" : "; " + time);
@@ -734,12 +722,40 @@ std::optional<SceneReference> StudyRun::verify(std::size_t s, StudyResult& resul
   StudyRow finest_row{scene.name, "reference L" + std::to_string(finest_solve.level), std::nullopt, cost_statistics(finest), std::nullopt,
                       head + verified.note, finest_solve.dir / "profile.csv"};
   result.rows.push_back(std::move(finest_row));
+  coarser_reference_rows(planned, verified, levels, half, result);
+  return verified;
+}
 
-  // The reference's own discretisation error: each coarser level, and the half increment, against the finest.
+/// The sampling uncertainty of the scene's finest level (its run at half the load increment,
+/// `half`, against it) in `verified.sampling`, and the note that says it or why there is none.
+std::string StudyRun::verify_in_time(const StudyPlannedScene& planned, SceneReference& verified, std::optional<ForceProfile>& half,
+                                     StudyResult& result) const {
+  if (!planned.time_check) return "";
+  const SolveOutcome& outcome = m_solves[*planned.time_check];
+  if (!outcome.stopped.empty())
+    result.stopped_references.push_back(planned.scene.name + " " + level_name(m_plan.solves[*planned.time_check]) + ": " + outcome.stopped);
+  if (!outcome.profile) return "no sampling uncertainty: the run at half the load increment failed (" + outcome.error + ")";
+  half = outcome.profile;
+  try {
+    verified.sampling = verify_sampling(verified.level_profiles.back(), *half, verified.tool);
+    return verified.sampling->summary();
+  } catch (const std::exception& e) {
+    return std::string("no sampling uncertainty: ") + e.what();
+  }
+}
+
+/// The reference's own discretisation error: a row for each coarser level, and one for the half
+/// increment, against the finest level.
+void StudyRun::coarser_reference_rows(const StudyPlannedScene& planned, const SceneReference& verified,
+                                      const std::vector<ReferenceLevel>& levels, const std::optional<ForceProfile>& half,
+                                      StudyResult& result) const {
+  const Scene& scene = planned.scene;
+  const ForceProfile& finest = verified.level_profiles.back();
+  const StudyReferenceSolve& finest_solve = m_plan.solves[planned.levels.back()];
   const auto against_finest = [&](const std::string& label, const ForceProfile& profile, const fs::path& file, const std::string& note) {
     StudyRow row{scene.name, label, std::nullopt, cost_statistics(profile), std::nullopt, note, file};
     try {
-      row.metrics = compare_profiles(at_common_times(profile, finest), at_common_times(finest, profile), tool);
+      row.metrics = compare_profiles(at_common_times(profile, finest), at_common_times(finest, profile), verified.tool);
     } catch (const std::exception& e) {
       row.note += std::string("; ") + e.what();
     }
@@ -754,7 +770,6 @@ std::optional<SceneReference> StudyRun::verify(std::size_t s, StudyResult& resul
   if (half)
     against_finest(level_name(m_plan.solves[*planned.time_check]), *half, m_plan.solves[*planned.time_check].dir / "profile.csv",
                    "the finest level at half the load increment against the finest at the study's (the common output times)");
-  return verified;
 }
 
 StudyRow StudyRun::model_row(const StudyPlannedScene& planned, const std::string& label, const StudyModelRun& run,
