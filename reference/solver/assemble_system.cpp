@@ -16,15 +16,49 @@
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/full_matrix.h>
 
+#include <petscmat.h>
+#include <petscvec.h>
+
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 namespace kerf::reference {
+
+namespace {
+
+/// A cell's matrix and right-hand side into the distributed system. A cell without a constrained
+/// DOF (nearly every cell) goes in as one n × n block, one MatSetValues and one VecSetValues,
+/// where deal.II's distribute_local_to_global calls MatSetValues once per row; a cell with one
+/// goes through distribute_local_to_global, which eliminates the constrained rows and columns.
+/// The entries and the order in which each one is summed are the same either way.
+template <class MatrixType, class VectorType>
+void add_cell_to_distributed(const dealii::FullMatrix<double>& cell_K, const dealii::Vector<double>& cell_rhs,
+                             const std::vector<dealii::types::global_dof_index>& dofs,
+                             const dealii::AffineConstraints<double>& constraints, MatrixType& K, VectorType& rhs) {
+  const std::size_t n = dofs.size();
+  bool constrained = false;
+  for (const auto i : dofs) constrained = constrained || constraints.is_constrained(i);
+  if (constrained) {
+    constraints.distribute_local_to_global(cell_K, cell_rhs, dofs, K, rhs);
+    return;
+  }
+  // PETSc's indices; FullMatrix keeps its rows one after another, as MatSetValues reads them.
+  std::array<PetscInt, 30> index{}; // a P2 tetrahedron's 30 DOFs at most
+  if (n > index.size()) throw std::logic_error("finite strain: more DOFs per cell than a quadratic tetrahedron's");
+  for (std::size_t i = 0; i < n; ++i) index[i] = static_cast<PetscInt>(dofs[i]);
+  const auto count = static_cast<PetscInt>(n);
+  PetscErrorCode error = MatSetValues(K.petsc_matrix(), count, index.data(), count, index.data(), &cell_K(0, 0), ADD_VALUES);
+  if (error == 0) error = VecSetValues(rhs, count, index.data(), cell_rhs.data(), ADD_VALUES);
+  if (error != 0) throw std::runtime_error("finite strain: PETSc could not add a cell's entries (error " + std::to_string(error) + ")");
+}
+
+} // namespace
 
 template <class Algebra>
 void FiniteStrainSolver::Impl::assemble(Algebra& la, const typename Algebra::VectorType& owned_state,
@@ -296,7 +330,7 @@ void FiniteStrainSolver::Impl::assemble_cells(const dealii::Vector<double>& stat
       if constexpr (serial_matrix)
         cell_scatter.add(c_index, cell_K, cell_rhs, local, *constraints, K_values, *rhs);
       else
-        constraints->distribute_local_to_global(cell_K, cell_rhs, local, K, *rhs);
+        add_cell_to_distributed(cell_K, cell_rhs, local, *constraints, K, *rhs);
     }
   }
   if (cohesive_law) assemble_cohesive(state, load, with_matrix, constraints, K, rhs, f_int);
