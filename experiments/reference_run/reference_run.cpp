@@ -309,6 +309,9 @@ private:
   void print_progress(std::size_t k, const reference::LoadStepReport& step, const SolvedSample& sample) const;
   LoadReason reason_of(std::size_t k) const;
   nlohmann::json manifest(double wall_seconds) const;
+  nlohmann::json solver_record() const;    ///< the manifest's "solver": size, linear solver, tools, load path
+  nlohmann::json load_path_record() const; ///< "solver" / "load_path": the loads planned and solved, by reason
+  nlohmann::json fracture_record() const;  ///< "fracture": the cohesive interface, or null
   [[nodiscard]] bool is_tied(const ReferenceTool& t) const { return t.coupling.kind == ReferenceToolCoupling::Kind::tied; }
 
   const Scene& m_scene;
@@ -709,6 +712,26 @@ nlohmann::json TrajectorySolve::manifest(double wall_seconds) const {
                {"tetrahedra", m_mesh.tets.rows()},
                {"element_size_m", m_scene.geometry.element_size},
                {"source", portable_path(m_scene.geometry.source)}};
+  m["solver"] = solver_record();
+  const reference::SolverTimings parts = m_solver->timings(); // rank 0's when distributed
+  m["timings"] = {{"wall_s", wall_seconds},
+                  {"solve_total_s", m_cp.solve_seconds},
+                  {"samples_solved", m_cp.solved},
+                  {"solver_parts_s", {{"assembly", parts.assembly_seconds},
+                                      {"factorization", parts.factorization_seconds},
+                                      {"solve", parts.solve_seconds},
+                                      {"communication", parts.communication_seconds}}}};
+  m["newton_iterations_total"] = m_newton_total;
+  m["energy"] = m_energy.to_json();
+  m["fracture"] = fracture_record();
+  m["samples"] = m_cp.samples;
+  m["stopped"] = m_stop.empty() ? nlohmann::json(nullptr) : nlohmann::json(m_stop);
+  m["partial"] = !m_stop.empty();
+  m["resumed_after_sample"] = m_resumed_from ? nlohmann::json(*m_resumed_from) : nlohmann::json(nullptr);
+  return m;
+}
+
+nlohmann::json TrajectorySolve::solver_record() const {
   nlohmann::json solver = {{"dofs", m_solver->dof_count()},
                            {"cells", m_solver->cell_count()},
                            {"linear_solver", m_solver->linear_solver_name()},
@@ -730,22 +753,7 @@ nlohmann::json TrajectorySolve::manifest(double wall_seconds) const {
     tools.push_back(t);
   }
   solver["tools"] = tools;
-  // The load path: every vertex of the motion, the requested samples, the ones adaptive sampling
-  // inserted; between two loads the tools move along the trajectory (LoadPath's motion).
-  std::size_t vertices_solved = 0, inserted_solved = 0;
-  for (std::size_t i = 0; i < m_cp.solved; ++i) {
-    const LoadReason r = reason_of(m_indices[i]);
-    vertices_solved += r == LoadReason::vertex;
-    inserted_solved += r == LoadReason::inserted;
-  }
-  solver["load_path"] = {{"motion", "the trajectory: between two loads the tools move along it (reference/load_path.hpp)"},
-                         {"vertex_tolerance_m", m_settings.vertex_tolerance},
-                         {"requested_samples", m_requested.size()},
-                         {"vertices", m_vertices.size()},
-                         {"loads_planned", m_indices.size()},
-                         {"loads_solved", m_cp.solved},
-                         {"vertices_not_requested", vertices_solved},
-                         {"inserted", inserted_solved}};
+  solver["load_path"] = load_path_record();
   if (m_settings.adaptive_force_change > 0.0)
     solver["adaptive_sampling"] = {{"force_change", m_settings.adaptive_force_change},
                                    {"min_travel_m", m_settings.adaptive_min_travel},
@@ -759,33 +767,40 @@ nlohmann::json TrajectorySolve::manifest(double wall_seconds) const {
   } else {
     solver["contact_penalty_Pa_per_m"] = m_solver->contact_penalty();
   }
-  m["solver"] = solver;
-  const reference::SolverTimings parts = m_solver->timings(); // rank 0's when distributed
-  m["timings"] = {{"wall_s", wall_seconds},
-                  {"solve_total_s", m_cp.solve_seconds},
-                  {"samples_solved", m_cp.solved},
-                  {"solver_parts_s", {{"assembly", parts.assembly_seconds},
-                                      {"factorization", parts.factorization_seconds},
-                                      {"solve", parts.solve_seconds},
-                                      {"communication", parts.communication_seconds}}}};
-  m["newton_iterations_total"] = m_newton_total;
-  m["energy"] = m_energy.to_json();
-  m["fracture"] = m_crack.active ? nlohmann::json{{"cohesive_law", "bilinear (Camacho-Ortiz effective opening), reference/cohesive/cohesive_law.hpp"},
-                                                  {"cohesive_strength_Pa", m_scene.material.cohesive_strength},
-                                                  {"fracture_toughness_J_per_m2", m_scene.material.fracture_toughness},
-                                                  {"interface_triangles", m_crack.interface_triangles},
-                                                  {"cohesive_zone_length_m", m_crack.zone_length},
-                                                  {"elements_in_zone", m_crack.elements_in_zone},
-                                                  {"viscous_time_s", m_settings.cohesive_viscous_time},
-                                                  {"viscosity_Pa_s_per_m", m_crack.viscosity},
-                                                  {"interface_area_m2", m_crack.interface_area},
-                                                  {"warning", m_crack.warning}}
-                                 : nlohmann::json(nullptr);
-  m["samples"] = m_cp.samples;
-  m["stopped"] = m_stop.empty() ? nlohmann::json(nullptr) : nlohmann::json(m_stop);
-  m["partial"] = !m_stop.empty();
-  m["resumed_after_sample"] = m_resumed_from ? nlohmann::json(*m_resumed_from) : nlohmann::json(nullptr);
-  return m;
+  return solver;
+}
+
+nlohmann::json TrajectorySolve::load_path_record() const {
+  // The load path: every vertex of the motion, the requested samples, the ones adaptive sampling
+  // inserted; between two loads the tools move along the trajectory (LoadPath's motion).
+  std::size_t vertices_solved = 0, inserted_solved = 0;
+  for (std::size_t i = 0; i < m_cp.solved; ++i) {
+    const LoadReason r = reason_of(m_indices[i]);
+    vertices_solved += r == LoadReason::vertex;
+    inserted_solved += r == LoadReason::inserted;
+  }
+  return {{"motion", "the trajectory: between two loads the tools move along it (reference/load_path.hpp)"},
+          {"vertex_tolerance_m", m_settings.vertex_tolerance},
+          {"requested_samples", m_requested.size()},
+          {"vertices", m_vertices.size()},
+          {"loads_planned", m_indices.size()},
+          {"loads_solved", m_cp.solved},
+          {"vertices_not_requested", vertices_solved},
+          {"inserted", inserted_solved}};
+}
+
+nlohmann::json TrajectorySolve::fracture_record() const {
+  return m_crack.active ? nlohmann::json{{"cohesive_law", "bilinear (Camacho-Ortiz effective opening), reference/cohesive/cohesive_law.hpp"},
+                                         {"cohesive_strength_Pa", m_scene.material.cohesive_strength},
+                                         {"fracture_toughness_J_per_m2", m_scene.material.fracture_toughness},
+                                         {"interface_triangles", m_crack.interface_triangles},
+                                         {"cohesive_zone_length_m", m_crack.zone_length},
+                                         {"elements_in_zone", m_crack.elements_in_zone},
+                                         {"viscous_time_s", m_settings.cohesive_viscous_time},
+                                         {"viscosity_Pa_s_per_m", m_crack.viscosity},
+                                         {"interface_area_m2", m_crack.interface_area},
+                                         {"warning", m_crack.warning}}
+                        : nlohmann::json(nullptr);
 }
 
 } // namespace
