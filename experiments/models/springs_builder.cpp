@@ -173,7 +173,11 @@ void set_integrator(SpringNetworkSetup& setup, const std::string& name) {
 
 } // namespace
 
-BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const ModelOptions& options) {
+namespace {
+
+/// The network's setting from the scene (its material, supports and tools, [models.springs]) and
+/// the command line's options (`integrator`).
+SpringNetworkSetup springs_setup(const Scene& scene, const ModelOptions& options) {
   SpringNetworkSetup setup;
   const SpringsModelSettings settings = scene.springs.value_or(SpringsModelSettings{});
   if (settings.integrator) set_integrator(setup, *settings.integrator);
@@ -222,13 +226,14 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
     }
   }
 
-  double duration = 0.0;
-  for (const Tool& t : scene.tools) duration = std::max(duration, sample(t.trajectory).duration());
-  const double interval = std::max(duration, 1e-3) / series_frames;
-  auto recorded = std::make_unique<RecordedSpringModel>(std::make_unique<SpringNetworkModel>(mesh, setup), interval, series_frames + 2);
-  const SpringNetworkModel* model = &recorded->model();
-  const SpringNetwork& net = model->network();
-  const CellIdentification& id = model->identification();
+  return setup;
+}
+
+/// The manifest's record of the network built from `setup`: integrator, lattice, spring
+/// constants, grasp and tearing (docs/force-profile.md).
+nlohmann::json springs_parameters(const Scene& scene, const SpringNetworkSetup& setup, const SpringNetworkModel& built) {
+  const SpringNetwork& net = built.network();
+  const CellIdentification& id = built.identification();
   nlohmann::json p;
   p["integrator"] = std::string(to_string(setup.integrator));
   if (setup.integrator == SpringIntegrator::symplectic_euler)
@@ -257,16 +262,28 @@ BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const Mo
       p["grasp_stiffness_N_per_m3"] = stylus.grasp_stiffness;
       p["grasp_disc_radius_m"] = stylus.grasp_disc_radius;
       p["grasp_anchors"] = nlohmann::json::array();
-      for (int k = 0; k < model->tool_count(); ++k)
-        p["grasp_anchors"].push_back({{"nodes", model->anchored_nodes(k)}, {"stiffness_sum_N_per_m", model->anchor_stiffness(k)}});
+      for (int k = 0; k < built.tool_count(); ++k)
+        p["grasp_anchors"].push_back({{"nodes", built.anchored_nodes(k)}, {"stiffness_sum_N_per_m", built.anchor_stiffness(k)}});
       break;
     }
-  p["explicit_stability_limit_s"] = model->stability_limit();
+  p["explicit_stability_limit_s"] = built.stability_limit();
   std::vector<int> attached;
-  for (int t = 0; t < model->tool_count(); ++t) attached.push_back(model->attached_nodes(t));
+  for (int t = 0; t < built.tool_count(); ++t) attached.push_back(built.attached_nodes(t));
   p["attached_nodes"] = attached;
   p["tearing"] = setup.tearing;
   if (setup.tearing) p["tensile_limit_Pa"] = setup.tensile_limit;
+  return p;
+}
+
+} // namespace
+
+BuiltModel build_springs_model(const Scene& scene, const TetMesh& mesh, const ModelOptions& options) {
+  const SpringNetworkSetup setup = springs_setup(scene, options);
+  double duration = 0.0;
+  for (const Tool& t : scene.tools) duration = std::max(duration, sample(t.trajectory).duration());
+  const double interval = std::max(duration, 1e-3) / series_frames;
+  auto recorded = std::make_unique<RecordedSpringModel>(std::make_unique<SpringNetworkModel>(mesh, setup), interval, series_frames + 2);
+  nlohmann::json p = springs_parameters(scene, setup, recorded->model());
   BuiltModel built{std::move(recorded), std::move(p)};
   auto* recording = static_cast<RecordedSpringModel*>(built.model.get());
   built.core = &recording->model();
