@@ -115,15 +115,11 @@ std::vector<FacePair<Cell>> find_face_pairs(const Cells& cells, const CohesiveIn
 
 std::vector<std::pair<unsigned, unsigned>> FiniteStrainSolver::Impl::cohesive_cell_pairs(const CohesiveInterfaceSpec& spec,
                                                                                      int plus_group, int minus_group) const {
-  // The faces are matched on a grid of 1e-6 of the smallest edge, as build_cohesive matches them
-  // (h_min is not known yet: the loads are set up after the partition).
-  double h = std::numeric_limits<double>::infinity();
-  for (const auto& cell : tria.active_cell_iterators())
-    for (unsigned l = 0; l < cell->n_lines(); ++l) h = std::min(h, cell->line(l)->diameter());
+  // The faces are matched on a grid of 1e-6 of the smallest edge, as build_cohesive matches them.
   const auto in = [this](dealii::types::boundary_id id, int group) { return in_group(id, group); };
   std::vector<std::pair<unsigned, unsigned>> cells;
   for (const auto& face : find_face_pairs<dealii::Triangulation<3>::active_cell_iterator>(tria.active_cell_iterators(), spec,
-                                                                                       plus_group, minus_group, in, 1e-6 * h))
+                                                                                       plus_group, minus_group, in, 1e-6 * h_min))
     cells.emplace_back(face.plus->active_cell_index(), face.minus->active_cell_index());
   return cells;
 }

@@ -120,6 +120,11 @@ void FiniteStrainSolver::Impl::build(const FiniteStrainProblem& problem) {
   make_grid(mesh, make_materials(problem));
   set_boundary_ids(mesh);
   if (settings.refinements > 0) tria.refine_global(static_cast<unsigned>(settings.refinements));
+  // `tria` is the whole (refined) mesh on every process, so every process finds the same h_min
+  // (the partition's cohesive face matching uses it already).
+  h_min = std::numeric_limits<double>::infinity();
+  for (const auto& cell : tria.active_cell_iterators())
+    for (unsigned l = 0; l < cell->n_lines(); ++l) h_min = std::min(h_min, cell->line(l)->diameter());
   distribute_grid(problem);
   setup_finite_element();
   std::vector<dealii::Point<3>> support = support_points();
@@ -353,11 +358,6 @@ void FiniteStrainSolver::Impl::setup_loads(const FiniteStrainProblem& problem) {
     tractions.emplace_back(group, t.total_force / area);
   }
   build_foundations(problem);
-
-  // `tria` is the whole (refined) mesh on every process, so every process finds the same h_min.
-  h_min = std::numeric_limits<double>::infinity();
-  for (const auto& cell : tria.active_cell_iterators())
-    for (unsigned l = 0; l < cell->n_lines(); ++l) h_min = std::min(h_min, cell->line(l)->diameter());
 
   tool = problem.tool;
   if (tool) {
