@@ -1,8 +1,7 @@
 #include "experiments/calibration/calibration.hpp"
 
 #include "experiments/models/run_model.hpp"
-#include "experiments/study/profile_metrics.hpp"
-#include "experiments/study/study_runner.hpp"
+#include "experiments/profile/profile_metrics.hpp"
 
 #include <algorithm>
 #include <cmath>

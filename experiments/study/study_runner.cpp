@@ -45,20 +45,6 @@ ReferenceRunner finite_element_reference() {
   };
 }
 
-ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b) {
-  std::map<std::string, std::vector<double>> times;
-  for (const ProfileRow& r : b.rows) times[r.tool].push_back(r.t);
-  for (auto& [tool, t] : times) std::sort(t.begin(), t.end());
-  ForceProfile out;
-  for (const ProfileRow& r : a.rows) {
-    const auto it = times.find(r.tool);
-    if (it == times.end()) continue;
-    const auto lo = std::lower_bound(it->second.begin(), it->second.end(), r.t - 1e-9);
-    if (lo != it->second.end() && *lo <= r.t + 1e-9) out.rows.push_back(r);
-  }
-  return out;
-}
-
 ScoredSamples represented_samples(const ForceProfile& reference, PhenomenonSet scene_phenomena, PhenomenonSet represented) {
   ScoredSamples out{reference, ""};
   bool separates = false;

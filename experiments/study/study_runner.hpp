@@ -9,7 +9,7 @@
 #include "experiments/models/run_model.hpp"
 #include "experiments/reference_run/reference_run.hpp"
 #include "experiments/study/cost_timing.hpp"
-#include "experiments/study/profile_metrics.hpp"
+#include "experiments/profile/profile_metrics.hpp"
 #include "experiments/study/reference_verification.hpp"
 #include "experiments/study/study_plan.hpp"
 #include "experiments/study/study_spec.hpp"
@@ -187,10 +187,5 @@ struct ScoredSamples {
 /// or with a crack (paper 001 Fig. 11: no-contact and deformation-1; after that the reference's body
 /// is cut, one the model does not have) — all rows at those times, every tool.
 ScoredSamples represented_samples(const ForceProfile& reference, PhenomenonSet scene_phenomena, PhenomenonSet represented);
-
-/// The rows of `a` whose tool and time (to 1e-9 s) also appear in `b`: the samples two runs have
-/// in common — a reference that stopped early (a blade pressed further than an uncut body can
-/// take) is compared on the samples it solved.
-ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b);
 
 } // namespace kerf

@@ -1,6 +1,6 @@
 // Study metrics against values computed by hand on a four-sample synthetic pair of profiles.
 
-#include "experiments/study/profile_metrics.hpp"
+#include "experiments/profile/profile_metrics.hpp"
 
 #include <gtest/gtest.h>
 

@@ -74,4 +74,9 @@ std::vector<double> sample_time_weights(const std::vector<double>& times);
 ProfileMetrics compare_profiles(const ForceProfile& model, const ForceProfile& reference, const std::string& tool,
                                 const std::optional<SteadyCuttingExpectation>& cutting = std::nullopt);
 
+/// The rows of `a` whose tool and time (to 1e-9 s) also appear in `b`: the samples two runs have
+/// in common — a reference that stopped early (a blade pressed further than an uncut body can
+/// take) is compared on the samples it solved.
+ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b);
+
 } // namespace kerf

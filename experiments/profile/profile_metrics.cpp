@@ -1,7 +1,8 @@
-#include "experiments/study/profile_metrics.hpp"
+#include "experiments/profile/profile_metrics.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <utility>
 #include <stdexcept>
 #include <vector>
@@ -103,6 +104,20 @@ ProfileMetrics compare_profiles(const ForceProfile& model, const ForceProfile& r
         ++count;
       }
     if (count > 0) out.steady_cutting_force_error = (sum / static_cast<double>(count) - cutting->force) / cutting->force;
+  }
+  return out;
+}
+
+ForceProfile at_common_times(const ForceProfile& a, const ForceProfile& b) {
+  std::map<std::string, std::vector<double>> times;
+  for (const ProfileRow& r : b.rows) times[r.tool].push_back(r.t);
+  for (auto& [tool, t] : times) std::sort(t.begin(), t.end());
+  ForceProfile out;
+  for (const ProfileRow& r : a.rows) {
+    const auto it = times.find(r.tool);
+    if (it == times.end()) continue;
+    const auto lo = std::lower_bound(it->second.begin(), it->second.end(), r.t - 1e-9);
+    if (lo != it->second.end() && *lo <= r.t + 1e-9) out.rows.push_back(r);
   }
   return out;
 }
