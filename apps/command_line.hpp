@@ -8,7 +8,7 @@
 //   CLI11's own statuses for a bad command line.
 
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "meshes/mesh_error.hpp"
 
 #include <CLI/CLI.hpp>

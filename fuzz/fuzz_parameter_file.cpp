@@ -1,6 +1,6 @@
 #include "fuzz/fuzz_targets.hpp"
 
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "fuzz/fuzz_input_file.hpp"
 

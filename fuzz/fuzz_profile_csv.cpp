@@ -1,6 +1,6 @@
 #include "fuzz/fuzz_targets.hpp"
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "fuzz/fuzz_input_file.hpp"
 
 #include <cmath>

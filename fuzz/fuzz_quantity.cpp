@@ -1,6 +1,6 @@
 #include "fuzz/fuzz_targets.hpp"
 
-#include "experiments/scene/quantity.hpp"
+#include "formats/scene/quantity.hpp"
 
 #include <cmath>
 #include <string_view>

@@ -29,11 +29,11 @@ public:
 /// through receive_device_state, after which received = accepted + dropped.
 void fuzz_device_protocol(std::span<const std::byte> data);
 
-/// Quantities with units (experiments/scene/quantity.hpp): the first byte picks the Dimension,
+/// Quantities with units (formats/scene/quantity.hpp): the first byte picks the Dimension,
 /// the rest is the text. Only QuantityError may be thrown; a result must be finite.
 void fuzz_quantity(std::span<const std::byte> data);
 
-/// Scene files (experiments/scene/scene_reader.hpp): the input is written as scene.toml in the
+/// Scene files (formats/scene/scene_reader.hpp): the input is written as scene.toml in the
 /// scratch folder (its `geo = "NAME.geo"` resolves to meshes/geo). Only SceneError may be thrown.
 /// TOML itself is parsed by the toml++ that kerf links (Debian's compiled libtomlplusplus, not
 /// instrumented): its header-only form, instrumented, stops at once on toml++ 3.3.0's issue #190
@@ -42,7 +42,7 @@ void fuzz_quantity(std::span<const std::byte> data);
 /// (tests/faults/test_fuzz_regressions.cpp), so the fuzzer works on kerf's reader above it.
 void fuzz_scene(std::span<const std::byte> data);
 
-/// Recorded trajectory CSV (experiments/trajectory/trajectory.hpp), resampled at 1 kHz. Only
+/// Recorded trajectory CSV (formats/trajectory/trajectory.hpp), resampled at 1 kHz. Only
 /// std::runtime_error may be thrown; samples must be finite, time-ordered at 1 ms.
 void fuzz_trajectory_csv(std::span<const std::byte> data);
 
@@ -50,7 +50,7 @@ void fuzz_trajectory_csv(std::span<const std::byte> data);
 /// thrown; ticks must be in order with every tool present and finite.
 void fuzz_session_csv(std::span<const std::byte> data);
 
-/// Force profile CSV (experiments/profile/force_profile.hpp), as the study reads it back. Only
+/// Force profile CSV (formats/profile/force_profile.hpp), as the study reads it back. Only
 /// std::runtime_error may be thrown; rows must be finite with a tool name.
 void fuzz_profile_csv(std::span<const std::byte> data);
 
@@ -62,7 +62,7 @@ void fuzz_profile_csv(std::span<const std::byte> data);
 /// calibrations only for its scenes).
 void fuzz_study(std::span<const std::byte> data);
 
-/// Parameter files (`kerf calibrate -o`, included by scenes; experiments/scene/scene_reader.hpp):
+/// Parameter files (`kerf calibrate -o`, included by scenes; formats/scene/scene_reader.hpp):
 /// the first byte picks one of the repository's scenes (experiments/scenes/*.toml, sorted), the
 /// rest is the parameter file given to read_scene after the scene's own includes. The same file
 /// goes through calibrated_models (the study's reader of parameter files). Only SceneError (scene)

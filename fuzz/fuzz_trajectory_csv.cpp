@@ -1,6 +1,6 @@
 #include "fuzz/fuzz_targets.hpp"
 
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/trajectory/trajectory.hpp"
 #include "fuzz/fuzz_input_file.hpp"
 
 #include <cmath>

@@ -24,10 +24,10 @@
 //
 //   write_seed_corpus OUT_DIR [--study STUDY.toml]... [--results PAGE.md]... SCENE.toml...
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "experiments/reference_run/reference_checkpoint.hpp"
-#include "experiments/scene/quantity.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/quantity.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/haptics/device_protocol.hpp"
 #include "realtime/haptics/session_recorder.hpp"
 

@@ -3,7 +3,7 @@
 // scene's, or a run's recorded positions), snapshotting at chosen times. What screenshots and the
 // replay of a fast model's run use; deterministic, so a picture at time T is reproducible.
 
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/trajectory/trajectory.hpp"
 #include "viewer/viewed_model.hpp"
 
 #include <functional>

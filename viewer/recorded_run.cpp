@@ -2,8 +2,8 @@
 
 #include "experiments/models/run_model.hpp"
 #include "experiments/records/content_hash.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "viewer/offline_stepping.hpp"
 #include "viewer/viewed_model.hpp"
 #include "viewer/von_mises.hpp"

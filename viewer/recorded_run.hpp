@@ -5,9 +5,9 @@
 // model rebuilt from the manifest (scene file, model name, integrator) and re-stepped through the
 // tool samples the profile recorded, snapshotted at evenly spaced times.
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 #include "viewer/body_view.hpp"
 #include "viewer/model_adapter.hpp"
 #include "viewer/pvd_series.hpp"

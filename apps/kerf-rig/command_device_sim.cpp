@@ -6,8 +6,8 @@
 
 #include "apps/kerf-rig/rig_commands.hpp"
 #include "experiments/models/run_model.hpp"
-#include "experiments/scene/resolve_scene.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/resolve_scene.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "meshes/atomic_file.hpp"
 #include "realtime/haptics/device_emulator.hpp"
 #include "realtime/haptics/device_specs.hpp"

@@ -7,8 +7,8 @@
 
 #include "apps/kerf-rig/haptic_session.hpp"
 #include "apps/kerf-rig/rig_commands.hpp"
-#include "experiments/scene/resolve_scene.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/resolve_scene.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/haptics/session_file.hpp"
 
 #include <memory>

@@ -6,9 +6,9 @@
 #include "apps/kerf-rig/haptic_session.hpp"
 
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/resolve_scene.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/resolve_scene.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/haptics/device_specs.hpp"
 #include "realtime/haptics/servo_loop.hpp"
 #include "realtime/haptics/udp_device.hpp"

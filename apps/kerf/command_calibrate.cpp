@@ -5,10 +5,10 @@
 
 #include "experiments/calibration/calibration.hpp"
 #include "apps/kerf/commands.hpp"
-#include "experiments/scene/scene_mesh.hpp"
+#include "formats/scene/scene_mesh.hpp"
 #include "experiments/models/session_replay.hpp"
-#include "experiments/scene/resolve_scene.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/resolve_scene.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/reference_cache.hpp"
 #include "experiments/study/stability_sweep.hpp"
 #include "experiments/study/study_runner.hpp"

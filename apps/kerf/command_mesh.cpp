@@ -3,10 +3,10 @@
 // (graded where the physics needs it: scene_mesh.hpp) and the parameters kerf derived for it.
 
 #include "apps/kerf/commands.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/quantity.hpp"
-#include "experiments/scene/resolve_scene.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/quantity.hpp"
+#include "formats/scene/resolve_scene.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "meshes/gmsh_io.hpp"
 #include "meshes/tet_quality.hpp"
 #include "meshes/vtu_writer.hpp"

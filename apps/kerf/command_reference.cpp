@@ -13,12 +13,12 @@
 #include "experiments/reference_run/reference_convergence.hpp"
 #include "experiments/reference_run/reference_run.hpp"
 #include "experiments/models/session_replay.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/quantity.hpp"
-#include "experiments/scene/resolve_scene.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/quantity.hpp"
+#include "formats/scene/resolve_scene.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/trajectory/trajectory.hpp"
 #include "reference/mpi_processes.hpp"
 
 #include <unistd.h>

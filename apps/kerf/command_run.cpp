@@ -5,10 +5,10 @@
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
 #include "experiments/records/run_record.hpp"
-#include "experiments/scene/scene_mesh.hpp"
+#include "formats/scene/scene_mesh.hpp"
 #include "experiments/models/session_replay.hpp"
-#include "experiments/scene/resolve_scene.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/resolve_scene.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/fracture/contact_length.hpp"
 
 #include <algorithm>

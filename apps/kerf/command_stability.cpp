@@ -3,8 +3,8 @@
 // and a map (PNG, PDF); with --doc, the model's edge is written into that Markdown page.
 
 #include "apps/kerf/commands.hpp"
-#include "experiments/scene/resolve_scene.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/resolve_scene.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/stability_sweep.hpp"
 #include "experiments/study/study_plots.hpp"
 #include "experiments/study/study_table.hpp"

@@ -6,7 +6,7 @@
 
 #include "apps/command_line.hpp"
 #include "apps/kerf/commands.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/blas_threads.hpp"
 #include "experiments/study/study_report.hpp"
 #include "apps/kerf/study_ranks.hpp"

@@ -9,9 +9,9 @@
 //   ./build/experiments/benchmarks/bench_edge
 
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
+#include "formats/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"
 #include "realtime/edge/geometric_cut.hpp"
 

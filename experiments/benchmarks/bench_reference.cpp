@@ -12,9 +12,9 @@
 // (getrusage; it only grows, so read it per benchmark in the order they run).
 
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
+#include "formats/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"
 #include "reference/finite_strain_solver.hpp"
 #include "tests/reference/reference_test_meshes.hpp"

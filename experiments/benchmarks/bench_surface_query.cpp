@@ -4,8 +4,8 @@
 //
 //   ./build/experiments/benchmarks/bench_surface_query
 
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "meshes/surface_mesh.hpp"
 
 #include <benchmark/benchmark.h>

@@ -1,7 +1,7 @@
 #include "experiments/calibration/calibration.hpp"
 
 #include "experiments/models/run_model.hpp"
-#include "experiments/profile/profile_metrics.hpp"
+#include "formats/profile/profile_metrics.hpp"
 
 #include <algorithm>
 #include <cmath>

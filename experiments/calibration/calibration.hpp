@@ -8,9 +8,9 @@
 
 #include "experiments/calibration/free_parameters.hpp"
 #include "experiments/calibration/nelder_mead.hpp"
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
 
 #include <optional>

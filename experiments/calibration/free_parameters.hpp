@@ -3,7 +3,7 @@
 // lives in a Scene, and the key and unit it is written with in a parameter file that a scene
 // includes (docs/scenes.md, "Including parameter files").
 
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 
 #include <span>
 #include <string_view>

@@ -3,7 +3,7 @@
 // a scene and built from it.
 
 #include "experiments/models/model_description.hpp"
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "meshes/vtu_writer.hpp"
 #include "realtime/tool_model.hpp"

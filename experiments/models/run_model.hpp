@@ -2,10 +2,10 @@
 // Running one model on one scene: the scene's trajectories sampled, the model stepped through
 // them with each step timed into a force profile (experiments/records/run_record.hpp writes it).
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/scene/scene.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/scene/scene.hpp"
+#include "formats/trajectory/trajectory.hpp"
 
 #include <filesystem>
 #include <vector>

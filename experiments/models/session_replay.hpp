@@ -3,8 +3,8 @@
 // (realtime/haptics/session_file.hpp) as trajectories, for `kerf run --trajectory` (a fast model
 // offline) and `kerf reference --trajectory` (the ground truth for the same motion).
 
-#include "experiments/scene/scene.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/scene/scene.hpp"
+#include "formats/trajectory/trajectory.hpp"
 
 #include <filesystem>
 #include <string>

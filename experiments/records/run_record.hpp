@@ -4,8 +4,8 @@
 // model's own outputs (the .vtu files of BuiltModel::write_outputs, written through VTK).
 
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/profile/force_profile.hpp"
-#include "experiments/scene/scene.hpp"
+#include "formats/profile/force_profile.hpp"
+#include "formats/scene/scene.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -13,7 +13,7 @@
 //
 // Includes reference/*.hpp only, which include no deal.II.
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "reference/finite_strain_solver.hpp"
 
 #include <nlohmann/json.hpp>

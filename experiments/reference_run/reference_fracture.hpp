@@ -6,8 +6,8 @@
 //
 // Includes reference/*.hpp only, which include no deal.II.
 
-#include "experiments/scene/cohesive_zone.hpp"
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/cohesive_zone.hpp"
+#include "formats/scene/scene.hpp"
 #include "realtime/force_sample.hpp"
 #include "reference/cohesive/cohesive_zone.hpp"
 #include "reference/finite_strain_solver.hpp"

@@ -2,9 +2,9 @@
 
 #include "experiments/reference_run/reference_checkpoint.hpp"
 #include "experiments/records/content_hash.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/trajectory/trajectory.hpp"
-#include "experiments/trajectory/trajectory_vertices.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/trajectory/trajectory.hpp"
+#include "formats/trajectory/trajectory_vertices.hpp"
 #include "meshes/atomic_file.hpp"
 #include "meshes/surface_mesh.hpp"
 #include "reference/load_path.hpp"
@@ -236,7 +236,7 @@ const char* load_reason_name(LoadReason r) {
   return "?";
 }
 
-/// The vertices of the tools' common motion (experiments/trajectory/trajectory_vertices.hpp).
+/// The vertices of the tools' common motion (formats/trajectory/trajectory_vertices.hpp).
 std::vector<std::size_t> motion_vertices(const ReferenceProblem& rp, double tolerance) {
   std::vector<SampledTrajectory> motions;
   for (const ReferenceTool& tool : rp.tools) {

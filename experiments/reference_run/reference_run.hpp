@@ -6,9 +6,9 @@
 //
 // Includes reference/*.hpp only, which include no deal.II.
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "experiments/reference_run/reference_fracture.hpp"
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
 #include "reference/finite_strain_solver.hpp"
 

@@ -11,7 +11,7 @@
 // passed several times within one run, so that its p99 is not the 6th or the 14th largest of a
 // few hundred steps but stands on ≥ 50 of them.
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 
 #include <cstddef>
 #include <functional>

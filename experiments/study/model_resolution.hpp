@@ -13,7 +13,7 @@
 // model's voxel size is a quarter of the scene's element size (edge_builder.cpp), the fracture model
 // has none of its own.
 
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 
 #include <string>
 #include <vector>

@@ -1,9 +1,9 @@
 #include "experiments/study/reference_cache.hpp"
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "experiments/models/run_model.hpp"
 #include "experiments/records/content_hash.hpp"
-#include "experiments/scene/scene_mesh.hpp"
+#include "formats/scene/scene_mesh.hpp"
 #include "reference/load_path.hpp"
 #include "reference/mpi_processes.hpp"
 

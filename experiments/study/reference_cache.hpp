@@ -12,7 +12,7 @@
 // key, so it is recomputed, never read.
 
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "reference/solver_version.hpp"
 

@@ -1,6 +1,6 @@
 #include "experiments/study/reference_verification.hpp"
 
-#include "experiments/profile/profile_metrics.hpp"
+#include "formats/profile/profile_metrics.hpp"
 #include "experiments/study/study_runner.hpp"
 
 #include <algorithm>

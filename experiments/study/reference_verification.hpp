@@ -14,7 +14,7 @@
 // available, the spread of the levels. The GCI of RMS |F| alone is no uncertainty of the profile:
 // the levels' RMS values may agree by coincidence while their profiles differ sample by sample.
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "experiments/study/solution_verification.hpp"
 
 #include <Eigen/Core>

@@ -2,7 +2,7 @@
 
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
-#include "experiments/scene/scene_mesh.hpp"
+#include "formats/scene/scene_mesh.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 // mesh size — and every run classified. Every model must fail gracefully past its edge: a clear
 // refusal or a guarded state, never a NaN force and never a crash.
 
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 
 #include <string>
 #include <vector>

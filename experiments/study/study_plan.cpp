@@ -2,7 +2,7 @@
 
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/model_resolution.hpp"
 
 #include <algorithm>

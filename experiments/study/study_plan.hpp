@@ -5,7 +5,7 @@
 // each calibration file) and the fitted calibrations. Every rank of an MPI study plans the same, and
 // study_reference_solves (publishing the library) plans the same again.
 
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 #include "experiments/study/reference_cache.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "realtime/phenomena.hpp"

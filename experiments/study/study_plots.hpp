@@ -2,7 +2,7 @@
 // The study's plots, drawn by experiments/study/plot_study.py (matplotlib, Debian's python3) from
 // kerf's own CSV files.
 
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene.hpp"
 
 #include <Eigen/Core>
 

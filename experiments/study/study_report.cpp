@@ -1,6 +1,6 @@
 #include "experiments/study/study_report.hpp"
 
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/study_plots.hpp"
 
 #include "meshes/atomic_file.hpp"

@@ -5,11 +5,11 @@
 // reference's own discretisation error in space and in time beside them, the costs of every model
 // timed undisturbed in a pass of their own, tables and plots (docs/studies.md).
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "experiments/models/run_model.hpp"
 #include "experiments/reference_run/reference_run.hpp"
 #include "experiments/study/cost_timing.hpp"
-#include "experiments/profile/profile_metrics.hpp"
+#include "formats/profile/profile_metrics.hpp"
 #include "experiments/study/reference_verification.hpp"
 #include "experiments/study/study_plan.hpp"
 #include "experiments/study/study_spec.hpp"

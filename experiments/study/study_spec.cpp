@@ -1,12 +1,12 @@
 // Study files (TOML) to StudySpec (study_spec.hpp): one function per table over the TOML reading
-// layer the scene reader uses (experiments/scene/toml_reader.hpp), so every error reads
+// layer the scene reader uses (formats/scene/toml_reader.hpp), so every error reads
 // "FILE:LINE:COLUMN: KEY: expected what, got what". The format: docs/studies.md, "Study file".
 
 #include "experiments/study/study_spec.hpp"
 
 #include "experiments/calibration/free_parameters.hpp"
 #include "experiments/models/model_description.hpp"
-#include "experiments/scene/toml_reader.hpp"
+#include "formats/scene/toml_reader.hpp"
 #include "experiments/study/model_resolution.hpp"
 
 #include <toml++/toml.h>

@@ -17,8 +17,8 @@
 // long; the force is read from 4 mm depth, with the bevel fully inside, to the end of the cut.
 
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -13,8 +13,8 @@
 //                  parts, the freed halves' recoil leaves the quasi-static ledger).
 
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -32,8 +32,8 @@
 //   equilibrium    until the tear the hands' pulls are equal and opposite (the base takes no x).
 
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -13,9 +13,9 @@
 // stops at a true residual of 1e-10 |b| per Newton step; it is compared at 1e-6.
 
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"
 #include "meshes/crack_split.hpp"
 #include "tests/experiments/run/grasp_on_box.hpp"

@@ -8,8 +8,8 @@
 
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/haptics/replay_device.hpp"
 #include "tests/viewer/overrun_comparison.hpp"
 #include "viewer/live_session.hpp"

@@ -11,8 +11,8 @@
 
 #include "experiments/calibration/calibration.hpp"
 #include "experiments/models/run_model.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // `include = "FILE.toml"` in a scene (docs/scenes.md): a parameter file's [models.*] keys replace
 // the scene's, are unit-converted like any value, and errors name the parameter file's line.
 
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>
 

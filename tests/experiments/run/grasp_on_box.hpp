@@ -5,8 +5,8 @@
 // stylus's grasp radius of the point under its start (at least the nearest one). A gmsh mesh of
 // the scene (scene_mesh) carries the disc itself.
 
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene.hpp"
 #include "meshes/tet_mesh.hpp"
 
 #include <limits>

@@ -6,8 +6,8 @@
 // node. Without the shared lock a study that solved two references at once published a level-1
 // clay_pull mesh with 793 nodes where the scene alone meshes to 794.
 
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/reference_cache.hpp"
 #include "reference/sparse_direct.hpp"
 

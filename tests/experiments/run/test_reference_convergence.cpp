@@ -7,9 +7,9 @@
 // log2(D_0 / D_1) is positive. The blade's force also grows with depth at every level.
 
 #include "experiments/reference_run/reference_convergence.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"
 #include "tests/experiments/run/grasp_on_box.hpp"
 

@@ -4,8 +4,8 @@
 
 #include "experiments/reference_run/reference_fracture.hpp"
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "reference/cohesive/cohesive_zone.hpp"
 
 #include <gtest/gtest.h>

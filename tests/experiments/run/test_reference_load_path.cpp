@@ -11,10 +11,10 @@
 // the study's target for the sampling uncertainty, 2 % of the peak force.
 
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/study_plan.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/trajectory/trajectory.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

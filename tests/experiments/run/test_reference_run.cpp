@@ -4,10 +4,10 @@
 // body), and a run resumed from its checkpoint gives the uninterrupted profile exactly.
 
 #include "experiments/reference_run/reference_run.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/study_runner.hpp"
-#include "experiments/trajectory/trajectory.hpp"
+#include "formats/trajectory/trajectory.hpp"
 #include "meshes/box_tet_mesh.hpp"
 #include "tests/experiments/run/grasp_on_box.hpp"
 

@@ -3,8 +3,8 @@
 // tetrahedron is positive, the physical groups are there, and `cut_plane` is conforming — each
 // of its triangles is a face of exactly two tetrahedra, one on each side of the plane.
 
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "meshes/tet_quality.hpp"
 
 #include <gtest/gtest.h>

@@ -3,7 +3,7 @@
 
 #include "experiments/study/reference_cache.hpp"
 
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/records/content_hash.hpp"
 #include "experiments/study/stability_sweep.hpp"
 #include "experiments/study/study_runner.hpp"

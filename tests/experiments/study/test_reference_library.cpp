@@ -10,13 +10,13 @@
 // and far above round-off. A stale entry (a scene, mesh rule or solver version changed since it
 // was published) is named with the command that re-publishes the library.
 
-#include "experiments/profile/force_profile.hpp"
+#include "formats/profile/force_profile.hpp"
 #include "realtime/blas_threads.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/study/study_spec.hpp"
 #include "experiments/calibration/calibration.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -2,7 +2,7 @@
 // catalogue run at the extreme corners of every axis without a NaN force or a crash.
 
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "experiments/study/stability_sweep.hpp"
 
 #include <gtest/gtest.h>

@@ -7,10 +7,10 @@
 #include "experiments/study/study_report.hpp"
 
 #include "experiments/models/model_catalogue.hpp"
-#include "experiments/scene/scene_mesh.hpp"
+#include "formats/scene/scene_mesh.hpp"
 #include "experiments/study/study_runner.hpp"
 #include "experiments/study/study_plots.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>
 

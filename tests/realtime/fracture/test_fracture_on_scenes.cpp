@@ -4,8 +4,8 @@
 
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/fracture/fracture_cutting_model.hpp"
 
 #include <gtest/gtest.h>

@@ -6,8 +6,8 @@
 
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/haptics/device_emulator.hpp"
 #include "realtime/haptics/servo_loop.hpp"
 #include "realtime/haptics/udp_device.hpp"

@@ -8,8 +8,8 @@
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
 #include "experiments/records/run_record.hpp"
-#include "experiments/scene/scene_mesh.hpp"
-#include "experiments/scene/scene_reader.hpp"
+#include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/scene_reader.hpp"
 #include "realtime/springs/network_embedding.hpp"
 #include "realtime/springs/spring_network_model.hpp"
 
