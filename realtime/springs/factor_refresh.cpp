@@ -1,6 +1,7 @@
 #include "realtime/springs/factor_refresh.hpp"
 
 #include <algorithm>
+#include <exception>
 
 namespace kerf {
 
@@ -20,7 +21,7 @@ void FactorRefresh::reserve(const SpringNetwork& net) {
 }
 
 bool FactorRefresh::start(NetworkSystem& system, const SpringNetwork& net, const Eigen::Matrix3Xd& x, double mass_weight,
-                          double stiffness_weight, long tag, CellTangent tangent) noexcept {
+                          double stiffness_weight, long tag, CellTangent tangent, bool reanalyse) noexcept {
   if (m_state.load(std::memory_order_acquire) != idle) return false;
   if (net.node_capacity() != m_net.node_capacity() || net.cell_count() != m_net.cell_count()) return false; // not reserved
   // The snapshot: what assembling and binding read and a tear changes (sizes fixed at reserve).
@@ -35,6 +36,7 @@ bool FactorRefresh::start(NetworkSystem& system, const SpringNetwork& net, const
   m_mass_weight = mass_weight;
   m_stiffness_weight = stiffness_weight;
   m_tangent = tangent;
+  m_reanalyse = reanalyse;
   m_result = Result{false, CellTangent::projected, tag};
   m_state.store(requested, std::memory_order_release);
   m_state.notify_one();
@@ -61,9 +63,19 @@ void FactorRefresh::work() {
     }
     if (s == stopping) return;
     NetworkSystem& system = *m_system;
-    // Splits since the system was last bound; a split the pattern cannot take is left to the
-    // servo (it rebuilds, which allocates), and the job reports no factor.
-    bool ok = m_net.node_count == system.bound_nodes() || system.bind_split_vertices(m_net);
+    // Re-analysed for the network as it is; or the splits since the system was last bound, where
+    // a split the pattern cannot take is left to the servo (it rebuilds, which allocates), and
+    // the job reports no factor.
+    bool ok = true;
+    if (m_reanalyse) {
+      try {
+        system.rebuild(m_net, NetworkSystem::SplitRoom::decoupled_shadows);
+      } catch (const std::exception&) {
+        ok = false; // off the lattice or CHOLMOD out of memory: no factor this time
+      }
+    } else {
+      ok = m_net.node_count == system.bound_nodes() || system.bind_split_vertices(m_net);
+    }
     CellTangent tangent = m_tangent;
     if (ok) {
       system.assemble(m_net, m_x, m_mass_weight, m_stiffness_weight, tangent);

@@ -3,8 +3,9 @@
 // so that the servo thread never factorises (docs/spring-network.md §2, "The kept factor and
 // its refresh"). The servo thread hands over a snapshot of the state (positions, and the cells'
 // corners, masses and constraints that a tear changes) and a NetworkSystem it does not touch
-// until the job is collected; the worker binds the snapshot's vertex splits into that system,
-// assembles A = w_m M + w_k K(x) with the exact tangent (the derivative of the forces) or the
+// until the job is collected; the worker binds the snapshot's vertex splits into that system
+// (or, asked to re-analyse, rebuilds it for the network as it is, with decoupled shadows:
+// allocation on the worker's side only), assembles A = w_m M + w_k K(x) with the exact tangent (the derivative of the forces) or the
 // projected one as asked, an exact A that is not positive definite (a buckling spring, a
 // collapsing cell) with the projected one instead, and factorises it.
 //
@@ -48,10 +49,12 @@ public:
   /// Servo thread: starts a job on `system` (which the caller leaves alone until `collect`) at
   /// positions `x` of `net`, A = mass_weight M + stiffness_weight K(x) with K of `tangent` (the
   /// exact one falls back to the projected one where A is not positive definite); `tag` is handed
-  /// back in the result. False (nothing started) while a job is running or not yet collected.
+  /// back in the result. `reanalyse`: the worker first rebuilds `system` for the snapshot's
+  /// network with decoupled shadows (NetworkSystem::SplitRoom), so that its factor is the torn
+  /// network's own size. False (nothing started) while a job is running or not yet collected.
   /// Allocation-free and lock-free (one release store and a futex wake).
   bool start(NetworkSystem& system, const SpringNetwork& net, const Eigen::Matrix3Xd& x, double mass_weight,
-             double stiffness_weight, long tag, CellTangent tangent = CellTangent::exact) noexcept;
+             double stiffness_weight, long tag, CellTangent tangent = CellTangent::exact, bool reanalyse = false) noexcept;
   /// A job was started and not yet collected.
   [[nodiscard]] bool busy() const noexcept { return m_state.load(std::memory_order_acquire) != idle; }
   /// The started job has finished (acquire: its results are visible to the caller).
@@ -72,6 +75,7 @@ private:
   Eigen::Matrix3Xd m_x;  ///< snapshot: positions
   double m_mass_weight = 0.0, m_stiffness_weight = 0.0;
   CellTangent m_tangent = CellTangent::exact;
+  bool m_reanalyse = false;
   Result m_result;       ///< written by the worker before the release store of `done`
   std::thread m_thread;
 };

@@ -7,6 +7,7 @@
 #include "realtime/springs/vector_clones.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -34,7 +35,9 @@ constexpr std::ptrdiff_t panel_floats(int nscol, int nsrow, int c) {
 
 
 /// The free degrees of freedom in natural order: those of the nodes (node order; an axis fixed
-/// by NodeConstraint has none), then, tear-ready, one shadow per free dof of every node.
+/// by NodeConstraint has none), then the shadows: with coupled shadows one per free dof of every
+/// node, with decoupled ones one per free dof of every node alone at its lattice point (one that
+/// has not split).
 struct FreeDofs {
   std::vector<int> natural;        ///< per entry 3 n + i: the dof of node n's axis i, or −1
   std::vector<int> shadow_natural; ///< per entry 3 n + i: its shadow's dof, or −1
@@ -42,7 +45,7 @@ struct FreeDofs {
   int first_shadow = 0;            ///< the shadows are count − first_shadow dofs from here
 };
 
-FreeDofs number_free_dofs(const SpringNetwork& net, bool tear_ready) {
+FreeDofs number_free_dofs(const SpringNetwork& net, NetworkSystem::SplitRoom room, const std::vector<int>& node_at_point) {
   FreeDofs d;
   d.natural.assign(static_cast<std::size_t>(3 * net.node_capacity()), -1);
   d.shadow_natural.assign(d.natural.size(), -1);
@@ -51,10 +54,15 @@ FreeDofs number_free_dofs(const SpringNetwork& net, bool tear_ready) {
     for (int i = 0; i < 3; ++i)
       if (!(net.constraint[static_cast<std::size_t>(p)] & (1u << i))) d.natural[static_cast<std::size_t>(3 * p + i)] = n++;
   d.first_shadow = n;
-  if (tear_ready)
+  // node_at_point (decoupled shadows): the node alone at each lattice point, −1 where a split left two.
+  std::vector<std::uint8_t> alone(static_cast<std::size_t>(net.node_count), room == NetworkSystem::SplitRoom::coupled_shadows ? 1 : 0);
+  for (const int p : node_at_point)
+    if (p >= 0) alone[static_cast<std::size_t>(p)] = 1;
+  if (room != NetworkSystem::SplitRoom::none)
     for (int p = 0; p < net.node_count; ++p)
       for (int i = 0; i < 3; ++i)
-        if (d.natural[static_cast<std::size_t>(3 * p + i)] >= 0) d.shadow_natural[static_cast<std::size_t>(3 * p + i)] = n++;
+        if (alone[static_cast<std::size_t>(p)] && d.natural[static_cast<std::size_t>(3 * p + i)] >= 0)
+          d.shadow_natural[static_cast<std::size_t>(3 * p + i)] = n++;
   d.count = n;
   return d;
 }
@@ -65,32 +73,38 @@ std::array<int, 2> cell_dofs(const SpringNetwork& net, const std::vector<int>& m
   return std::array<int, 2>{map[k], shadow[k]};
 }
 
-/// The lower triangle of the n x n cell-coupling pattern (every pair of dofs, or shadows, of
-/// nodes sharing a cell) with dofs numbered by `map` and `shadow`; entries 1.
+/// The lower triangle of the n x n cell-coupling pattern (every pair of dofs, or coupled
+/// shadows, of nodes sharing a cell) with dofs numbered by `map` and `shadow`, and the diagonal
+/// of decoupled shadows; entries 1.
 NetworkSystem::Matrix lower_pattern(const SpringNetwork& net, const std::vector<int>& map, const std::vector<int>& shadow, int n,
-                                    bool tear_ready) {
+                                    NetworkSystem::SplitRoom room) {
+  const bool coupled = room == NetworkSystem::SplitRoom::coupled_shadows;
+  const std::vector<int> none(coupled ? 0 : shadow.size(), -1);
+  const std::vector<int>& coupled_shadow = coupled ? shadow : none;
   std::vector<Eigen::Triplet<double, int>> triplets;
-  triplets.reserve(static_cast<std::size_t>(net.cell_count()) * (tear_ready ? 1200 : 300));
+  triplets.reserve(static_cast<std::size_t>(net.cell_count()) * (coupled ? 1200 : 300));
   for (int cell = 0; cell < net.cell_count(); ++cell)
     for (int a = 0; a < 24; ++a)
-      for (const int r : cell_dofs(net, map, shadow, cell, a)) {
+      for (const int r : cell_dofs(net, map, coupled_shadow, cell, a)) {
         if (r < 0) continue;
         for (int b = 0; b < 24; ++b)
-          for (const int c : cell_dofs(net, map, shadow, cell, b))
+          for (const int c : cell_dofs(net, map, coupled_shadow, cell, b))
             if (c >= 0 && r >= c) triplets.emplace_back(r, c, 1.0);
       }
+  if (room == NetworkSystem::SplitRoom::decoupled_shadows)
+    for (const int d : shadow)
+      if (d >= 0) triplets.emplace_back(d, d, 1.0);
   NetworkSystem::Matrix m(n, n);
   m.setFromTriplets(triplets.begin(), triplets.end());
   m.makeCompressed();
   return m;
 }
 
-/// Fill-reducing ordering: the lattice's geometric nested dissection (lattice_dissection.hpp;
-/// a node and its shadow take their lattice point's rank, dofs of one point stay together), as
-/// the permutation given to CHOLMOD (entry new = natural dof); empty when a node is off the
-/// block's lattice.
-std::vector<int> lattice_ordering(const SpringNetwork& net, const FreeDofs& dofs) {
-  const int n = dofs.count;
+/// Fill-reducing ordering of the first `n` natural dofs (those in the factor): the lattice's
+/// geometric nested dissection (lattice_dissection.hpp; a node and its coupled shadow take their
+/// lattice point's rank, dofs of one point stay together), as the permutation given to CHOLMOD
+/// (entry new = natural dof); empty when a node is off the block's lattice.
+std::vector<int> lattice_ordering(const SpringNetwork& net, const FreeDofs& dofs, int n) {
   std::vector<int> given;
   const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
   const std::vector<int> rank = lattice_nested_dissection(np);
@@ -106,7 +120,7 @@ std::vector<int> lattice_ordering(const SpringNetwork& net, const FreeDofs& dofs
     const std::int64_t r = rank[static_cast<std::size_t>(gi.x() + np.x() * (gi.y() + np.y() * gi.z()))];
     for (int i = 0; i < 3; ++i)
       for (const int k : {dofs.natural[static_cast<std::size_t>(3 * p + i)], dofs.shadow_natural[static_cast<std::size_t>(3 * p + i)]})
-        if (k >= 0) key[static_cast<std::size_t>(k)] = r * (2 * static_cast<std::int64_t>(n)) + k;
+        if (k >= 0 && k < n) key[static_cast<std::size_t>(k)] = r * (2 * static_cast<std::int64_t>(n)) + k;
   }
   if (on_lattice) {
     given.resize(static_cast<std::size_t>(n));
@@ -116,14 +130,18 @@ std::vector<int> lattice_ordering(const SpringNetwork& net, const FreeDofs& dofs
   return given;
 }
 
-/// CHOLMOD's symbolic analysis of the natural `pattern` (lower triangle) for a supernodal
-/// factor: the lattice's ordering `given` (if any) against AMD, CHOLMOD keeping the one with the
-/// smaller factor. Both are deterministic; METIS (CHOLMOD's default tries it when AMD's fill is
-/// high) is not, so it is never tried. `ordering` gets the one kept. The factor's numeric
-/// storage and Common's workspace are allocated now rather than on the first factorisation.
-cholmod_factor* analyse_pattern(cholmod_common& common, NetworkSystem::Matrix& pattern, std::vector<int>& given,
+/// CHOLMOD's symbolic analysis of the natural `pattern`'s leading n x n block (lower triangle;
+/// the rest, decoupled shadows, stays out of the factor) for a supernodal factor: the lattice's
+/// ordering `given` (if any) against AMD, CHOLMOD keeping the one with the smaller factor. Both
+/// are deterministic; METIS (CHOLMOD's default tries it when AMD's fill is high) is not, so it is
+/// never tried. `ordering` gets the one kept. The factor's numeric storage and Common's
+/// workspace are allocated now rather than on the first factorisation.
+cholmod_factor* analyse_pattern(cholmod_common& common, NetworkSystem::Matrix& pattern, int n, std::vector<int>& given,
                                 NetworkSystem::FillOrdering& ordering) {
   cholmod_sparse view = cholmod_view(pattern, -1);
+  // The leading block: its columns' rows are all below n (nothing couples a decoupled shadow).
+  view.nrow = view.ncol = static_cast<std::size_t>(n);
+  view.nzmax = static_cast<std::size_t>(pattern.outerIndexPtr()[n]);
   common.nmethods = given.empty() ? 1 : 2;
   common.method[0].ordering = given.empty() ? CHOLMOD_AMD : CHOLMOD_GIVEN;
   common.method[1].ordering = CHOLMOD_AMD;
@@ -137,13 +155,15 @@ cholmod_factor* analyse_pattern(cholmod_common& common, NetworkSystem::Matrix& p
   return factor;
 }
 
-/// The dofs and shadows renumbered in the factor's order (perm[new] = natural); a shadow is
+/// The dofs and shadows renumbered in the factor's order (perm[new] = natural for the first
+/// `factored` ones; the decoupled shadows after them keep their natural numbers); a shadow is
 /// unused (`in_use` 0) until a copy takes it.
-void number_in_factor_order(const FreeDofs& dofs, const int* perm, std::vector<int>& dof_of, std::vector<int>& shadow_of,
+void number_in_factor_order(const FreeDofs& dofs, const int* perm, int factored, std::vector<int>& dof_of, std::vector<int>& shadow_of,
                             std::vector<std::uint8_t>& in_use) {
   const int n = dofs.count;
   std::vector<int> new_of_natural(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) new_of_natural[static_cast<std::size_t>(perm[k])] = k;
+  for (int k = 0; k < factored; ++k) new_of_natural[static_cast<std::size_t>(perm[k])] = k;
+  for (int k = factored; k < n; ++k) new_of_natural[static_cast<std::size_t>(k)] = k;
   dof_of.assign(dofs.natural.size(), -1);
   for (std::size_t k = 0; k < dofs.natural.size(); ++k) {
     if (dofs.natural[k] >= 0) dof_of[k] = new_of_natural[static_cast<std::size_t>(dofs.natural[k])];
@@ -153,16 +173,19 @@ void number_in_factor_order(const FreeDofs& dofs, const int* perm, std::vector<i
 }
 
 /// The node at each lattice point (−1 if none), for finding the original of a copy (same rest
-/// position); throws if a node is off the block's lattice or two share a point (a torn network).
-std::vector<int> node_at_lattice_point(const SpringNetwork& net) {
+/// position); throws if a node is off the block's lattice, or if two share a point (a torn
+/// network) unless `torn` allows it: then the point holds −1 (its node has split once already).
+std::vector<int> node_at_lattice_point(const SpringNetwork& net, bool torn) {
   const Eigen::Vector3i np = net.block.cells + Eigen::Vector3i::Ones();
   std::vector<int> node_at(static_cast<std::size_t>(np.prod()), -1);
+  std::vector<std::uint8_t> taken(node_at.size(), 0);
   for (int p = 0; p < net.node_count; ++p) {
     const Eigen::Vector3i g = ((net.rest.col(p) - net.block.origin) / net.block.cell_size).array().round().cast<int>();
     if ((g.array() < 0).any() || (g.array() >= np.array()).any()) throw std::invalid_argument("NetworkSystem: a node off the block's lattice");
-    int& at = node_at[static_cast<std::size_t>(g.x() + np.x() * (g.y() + np.y() * g.z()))];
-    if (at >= 0) throw std::invalid_argument("NetworkSystem: a tear-ready pattern needs an untorn network");
-    at = p;
+    const auto k = static_cast<std::size_t>(g.x() + np.x() * (g.y() + np.y() * g.z()));
+    if (taken[k] && !torn) throw std::invalid_argument("NetworkSystem: a tear-ready pattern needs an untorn network");
+    node_at[k] = taken[k] ? -1 : p;
+    taken[k] = 1;
   }
   return node_at;
 }
@@ -192,41 +215,49 @@ void NetworkSystem::release() noexcept {
   if (m_factor) cholmod_free_factor(&m_factor, m_common);
 }
 
-int NetworkSystem::supernode_count() const { return m_factor ? static_cast<int>(m_factor->nsuper) : 0; }
+int NetworkSystem::supernode_count() const {
+  return (m_factor ? static_cast<int>(m_factor->nsuper) : 0) + (dof_count() - m_factor_dofs);
+}
 
-int NetworkSystem::supernode_start(int s) const { return static_cast<const int*>(m_factor->super)[s]; }
+int NetworkSystem::supernode_start(int s) const {
+  const int nsuper = m_factor ? static_cast<int>(m_factor->nsuper) : 0;
+  return s < nsuper ? static_cast<const int*>(m_factor->super)[s] : m_factor_dofs + (s - nsuper);
+}
 
 double NetworkSystem::factor_entries() const {
   if (!m_factor) return 0.0;
-  return m_factor->is_super ? static_cast<double>(m_factor->xsize) : static_cast<double>(m_factor->nzmax);
+  return (m_factor->is_super ? static_cast<double>(m_factor->xsize) : static_cast<double>(m_factor->nzmax)) + (dof_count() - m_factor_dofs);
 }
 
-void NetworkSystem::rebuild(const SpringNetwork& net, bool tear_ready) {
+void NetworkSystem::rebuild(const SpringNetwork& net, SplitRoom room) {
   release();
   m_factorized = false;
-  const FreeDofs dofs = number_free_dofs(net, tear_ready);
+  m_room = room;
+  m_bound_decoupled = false;
+  m_node_at_point.clear();
+  if (room != SplitRoom::none) m_node_at_point = node_at_lattice_point(net, room == SplitRoom::decoupled_shadows);
+  const FreeDofs dofs = number_free_dofs(net, room, m_node_at_point);
   const int n = dofs.count;
-  m_matrix = lower_pattern(net, dofs.natural, dofs.shadow_natural, n, tear_ready);
+  m_factor_dofs = room == SplitRoom::decoupled_shadows ? dofs.first_shadow : n;
+  m_matrix = lower_pattern(net, dofs.natural, dofs.shadow_natural, n, room);
   m_bound_cells = net.cell_nodes;
   m_bound_nodes = net.node_count;
-  m_node_at_point.clear();
   m_shadow_of.assign(dofs.natural.size(), -1);
   m_dof_in_use.assign(static_cast<std::size_t>(n), 1);
-  if (n == 0) {
+  if (m_factor_dofs == 0) {
     m_dof_of.assign(dofs.natural.size(), -1);
     m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
     m_diagonal.clear();
     return;
   }
 
-  // Ordering and symbolic analysis by CHOLMOD on the natural pattern.
-  std::vector<int> given = lattice_ordering(net, dofs);
-  m_factor = analyse_pattern(*m_common, m_matrix, given, m_ordering);
-  number_in_factor_order(dofs, static_cast<const int*>(m_factor->Perm), m_dof_of, m_shadow_of, m_dof_in_use);
-  if (tear_ready) m_node_at_point = node_at_lattice_point(net);
+  // Ordering and symbolic analysis by CHOLMOD on the natural pattern (the factor's part).
+  std::vector<int> given = lattice_ordering(net, dofs, m_factor_dofs);
+  m_factor = analyse_pattern(*m_common, m_matrix, m_factor_dofs, given, m_ordering);
+  number_in_factor_order(dofs, static_cast<const int*>(m_factor->Perm), m_factor_dofs, m_dof_of, m_shadow_of, m_dof_in_use);
 
   // Lower-triangular pattern in the factor's order, and each cell entry's place in it.
-  m_matrix = lower_pattern(net, m_dof_of, m_shadow_of, n, tear_ready);
+  m_matrix = lower_pattern(net, m_dof_of, m_shadow_of, n, room);
   m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
   for (int cell = 0; cell < net.cell_count(); ++cell) bind_cell(net, cell);
   m_diagonal.assign(static_cast<std::size_t>(n), -1);
@@ -270,6 +301,7 @@ void NetworkSystem::size_solve_workspaces() {
   m_dots.assign(widest, 0.0);
   m_inverse_diagonal.assign(n, 0.0);
   m_solution_single.assign(single ? n : 0, 0.0f);
+  m_shadow_inverse_root.assign(n - static_cast<std::size_t>(m_factor_dofs), 0.0);
   m_rows_single.assign(single ? widest + tallest + 32 : 0, 0.0f);
   m_rows_split = static_cast<int>(widest) + 16;
 }
@@ -350,6 +382,12 @@ bool NetworkSystem::bind_split_vertices(const SpringNetwork& net) noexcept {
     }
   }
   m_bound_nodes = net.node_count;
+  if (m_room == SplitRoom::decoupled_shadows) {
+    // No entry to re-place: the matrix stays the one before the splits (the kept factor's).
+    m_bound_decoupled = true;
+    m_factorized = false;
+    return true;
+  }
   // Re-place the entries of the cells whose corners changed.
   for (int cell = 0; cell < net.cell_count(); ++cell)
     if (net.cell_nodes[static_cast<std::size_t>(cell)] != m_bound_cells[static_cast<std::size_t>(cell)]) {
@@ -620,6 +658,7 @@ void inverse_block_solve(const cholmod_factor& L, const float* blocks, const std
 } // namespace
 
 bool NetworkSystem::factorize() noexcept {
+  if (m_bound_decoupled) return m_factorized = false; // the matrix is not the torn network's: rebuild
   if (!m_factor) return m_factorized = dof_count() == 0;
   {
     // OpenBLAS's pool would allocate per call and put its threads on the servo's critical path.
@@ -642,6 +681,13 @@ bool NetworkSystem::factorize() noexcept {
     if (m_precision == SolvePrecision::single_precision)
       invert_supernode_blocks(*m_factor, lx, m_inverse_diagonal.data(), m_inverse_block_at.data(), m_inverse_column.data(),
                               m_inverse_blocks.data() + m_inverse_align);
+    // The decoupled shadows' block: L = √A_dd there.
+    const double* values = m_matrix.valuePtr();
+    for (int d = m_factor_dofs; d < dof_count(); ++d) {
+      const double a = values[m_diagonal[static_cast<std::size_t>(d)]];
+      if (!(a > 0.0) || !std::isfinite(a)) return m_factorized = false;
+      m_shadow_inverse_root[static_cast<std::size_t>(d - m_factor_dofs)] = 1.0 / std::sqrt(a);
+    }
   }
   return m_factorized;
 }
@@ -788,6 +834,10 @@ void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noex
     std::copy(rhs.data(), rhs.data() + n, out.data());
     supernodal_solve_double(*m_factor, static_cast<const double*>(m_factor->x), m_inverse_diagonal.data(), out.data(), m_below.data(),
                             m_dots.data());
+    for (int d = m_factor_dofs; d < n; ++d) {
+      const double r = m_shadow_inverse_root[static_cast<std::size_t>(d - m_factor_dofs)];
+      out[d] *= r * r;
+    }
     return;
   }
   for (int k = 0; k < n; ++k) m_solution_single[static_cast<std::size_t>(k)] = static_cast<float>(rhs[k]);
@@ -800,6 +850,7 @@ bool NetworkSystem::forward_solve_in_place(float* y) noexcept {
   if (dof_count() == 0) return true;
   inverse_block_forward(*m_factor, m_inverse_blocks.data() + m_inverse_align, m_inverse_block_at.data(), y, m_rows_single.data(),
                         m_rows_single.data() + m_rows_split, true);
+  scale_decoupled_shadows(y, 1);
   return true;
 }
 
@@ -808,6 +859,7 @@ bool NetworkSystem::backward_solve_in_place(float* x) noexcept {
   if (dof_count() == 0) return true;
   inverse_block_backward(*m_factor, m_inverse_blocks.data() + m_inverse_align, m_inverse_block_at.data(), x, m_rows_single.data(),
                          m_rows_single.data() + m_rows_split);
+  scale_decoupled_shadows(x, 1);
   return true;
 }
 
@@ -816,7 +868,15 @@ bool NetworkSystem::solve_in_place() noexcept {
   if (dof_count() == 0) return true;
   inverse_block_solve(*m_factor, m_inverse_blocks.data() + m_inverse_align, m_inverse_block_at.data(), m_solution_single.data(),
                       m_rows_single.data(), m_rows_single.data() + m_rows_split);
+  scale_decoupled_shadows(m_solution_single.data(), 2);
   return true;
+}
+
+void NetworkSystem::scale_decoupled_shadows(float* v, int power) const noexcept {
+  for (int d = m_factor_dofs; d < dof_count(); ++d) {
+    const double r = m_shadow_inverse_root[static_cast<std::size_t>(d - m_factor_dofs)];
+    v[d] = static_cast<float>(static_cast<double>(v[d]) * (power == 2 ? r * r : r));
+  }
 }
 
 } // namespace kerf

@@ -57,14 +57,35 @@ public:
   /// vertex split (VertexTearing: the copy takes the original's rest position and constraint,
   /// each vertex splits once) is bound by `bind_split_vertices` without a new analysis. Unused
   /// shadows get a unit diagonal (decoupled, solution zero). The factor is larger (about twice
-  /// the dofs). Needs an untorn network.
-  void rebuild(const SpringNetwork& net, bool tear_ready = false);
+  /// the dofs, four times the entries). Needs an untorn network.
+  void rebuild(const SpringNetwork& net, bool tear_ready = false) {
+    rebuild(net, tear_ready ? SplitRoom::coupled_shadows : SplitRoom::none);
+  }
 
-  /// After vertex splits on a tear-ready system: gives each new node (a copy) its original's
-  /// shadow dofs and re-places the entries of the cells whose corners changed. Allocation-free.
-  /// False if the system is not tear-ready or a split does not fit the shadows (a second copy of
-  /// a vertex, a changed constraint): then `rebuild` is needed.
+  /// Room for vertex splits in the system (`rebuild`).
+  enum class SplitRoom {
+    none,            ///< the network's own dofs
+    coupled_shadows, ///< `tear_ready` above: splits bound into the pattern, any later assembly takes them
+    /// Each node that has not split (no other node at its lattice point; the network may be
+    /// torn already) gets a shadow that stays decoupled: its dofs come after every node's, outside
+    /// the Cholesky factor, as a diagonal block of their own (half the node's diagonal, as an
+    /// unused coupled shadow gets). A split binds the copy to its original's shadow dofs without
+    /// re-placing any entry (`bind_split_vertices`), so the system is then the matrix before the
+    /// split, for a kept factor that SplitCorrection corrects; assembling it again needs a
+    /// `rebuild` (`factorize` says false until then). The factor is the network's own size.
+    decoupled_shadows
+  };
+  void rebuild(const SpringNetwork& net, SplitRoom room);
+
+  /// After vertex splits on a system with room for them: gives each new node (a copy) its
+  /// original's shadow dofs and, with coupled shadows, re-places the entries of the cells whose
+  /// corners changed. Allocation-free. False if the system has no room or a split does not fit
+  /// the shadows (a second copy of a vertex, a changed constraint): then `rebuild` is needed.
   bool bind_split_vertices(const SpringNetwork& net) noexcept;
+  /// Decoupled shadows (SplitRoom::decoupled_shadows): the dofs [0, factor_dofs()) are in the
+  /// Cholesky factor, the rest are the decoupled shadows' (a diagonal block). Otherwise dof_count().
+  [[nodiscard]] int factor_dofs() const { return m_factor_dofs; }
+  [[nodiscard]] SplitRoom split_room() const { return m_room; }
 
   /// The fill-reducing ordering `rebuild` chose: the lattice's nested dissection, or AMD when
   /// that gave the smaller factor (or a node is off the block's lattice).
@@ -85,8 +106,10 @@ public:
   void assemble(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double mass_weight, double stiffness_weight,
                 CellTangent tangent = CellTangent::projected) noexcept;
   /// Numeric supernodal LLᵀ of the assembled A on the analysed pattern (SupernodalCholesky on
-  /// the matrix already in the factor's order, OpenBLAS on one thread; allocation-free). False
-  /// if A is not positive definite.
+  /// the matrix already in the factor's order, OpenBLAS on one thread; allocation-free), and the
+  /// decoupled shadows' diagonal block. False if A is not positive definite, or if splits were
+  /// bound to decoupled shadows since the last `rebuild` (the assembled matrix would not be the
+  /// torn network's).
   bool factorize() noexcept;
   /// out = A⁻¹ rhs with the last factorisation (both of size dof_count(); out is not resized).
   /// Double precision: L y = rhs, then Lᵀ out = y, supernode by supernode on CHOLMOD's
@@ -120,7 +143,7 @@ public:
   /// Entry (d, d) of the assembled matrix.
   [[nodiscard]] double diagonal(int d) const { return m_matrix.valuePtr()[m_diagonal[static_cast<std::size_t>(d)]]; }
   /// The factor's supernodes: their count, and the first column of each (supernode_start(count)
-  /// = dof_count()).
+  /// = dof_count()); each decoupled shadow dof counts as a supernode of one column.
   [[nodiscard]] int supernode_count() const;
   [[nodiscard]] int supernode_start(int s) const;
   /// Nodes bound so far (rebuild, then each `bind_split_vertices`).
@@ -137,6 +160,9 @@ private:
   bool bind_cell(const SpringNetwork& net, int cell) noexcept;
   /// Sizes the numeric factorisation's and the solve's workspaces for the analysed factor (`rebuild`).
   void size_solve_workspaces();
+  /// v_d ← v_d (A_dd)^(−power/2) on the decoupled shadows' dofs (the diagonal block's L = √A_dd:
+  /// power 1 for one triangular solve, 2 for both).
+  void scale_decoupled_shadows(float* v, int power) const noexcept;
 
   std::vector<int> m_dof_of;
   Matrix m_matrix;
@@ -146,6 +172,10 @@ private:
   std::vector<int> m_diagonal; ///< value index of each dof's diagonal
   std::vector<int> m_shadow_of;             ///< tear-ready: shadow dof of node n's axis i (3 n + i), or −1
   std::vector<std::uint8_t> m_dof_in_use;   ///< per dof: 0 for a shadow no copy has taken yet
+  SplitRoom m_room = SplitRoom::none;
+  int m_factor_dofs = 0;                    ///< dofs in the Cholesky factor (the rest: decoupled shadows)
+  bool m_bound_decoupled = false;           ///< a split bound to a decoupled shadow since `rebuild`
+  std::vector<double> m_shadow_inverse_root; ///< decoupled shadows: 1 / √A_dd, dof d = factor_dofs() + k
   std::vector<int> m_node_at_point;         ///< tear-ready: the original node at each lattice point
   std::vector<std::array<int, 8>> m_bound_cells; ///< the cell corners the entries were placed for
   int m_bound_nodes = 0;

@@ -37,10 +37,10 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
     m_refresh->wait();
     if (m_refresh->busy()) m_refresh->collect(); // drop it: the pattern changes
   }
-  // Tear-ready only on an untorn network (one still on its lattice); a rebuild after a split
-  // that did not fit is plain. Both systems get the same (deterministic) analysis.
+  // Room for splits only on an untorn network (one still on its lattice); a rebuild after a
+  // split that did not fit is plain. Both systems get the same (deterministic) analysis.
   const bool tear_ready = m_tear_ready && LatticeForces(net).applies(net);
-  for (auto& s : m_systems) s->rebuild(net, tear_ready);
+  for (auto& s : m_systems) s->rebuild(net, tear_ready ? split_room() : NetworkSystem::SplitRoom::none);
   m_active = 0;
   if (m_refresh) m_refresh->reserve(net);
   m_correction.reserve(active().dof_count());
@@ -65,6 +65,13 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_splits = 0;
   // Quasi-static regulariser: 1e-8 of the stiffness-to-mass scale k₁ / (cell mass / 8).
   m_static_regularisation = 1e-8 * net.stiffness.edge / (net.cell_mass / 8.0);
+}
+
+NetworkSystem::SplitRoom NewtonStepper::split_room() const {
+  // Implicit Euler never assembles after a split on the servo thread (the worker re-analyses the
+  // torn network for each refresh), so its shadows stay out of the factor; the other modes
+  // refactorise the torn network on the calling thread, into the pattern's room.
+  return m_mode == Mode::implicit_euler ? NetworkSystem::SplitRoom::decoupled_shadows : NetworkSystem::SplitRoom::coupled_shadows;
 }
 
 double NewtonStepper::mass_weight(double dt) const { return m_mode == Mode::quasi_static ? m_static_regularisation : 1.0 / (dt * dt); }
@@ -147,8 +154,10 @@ bool NewtonStepper::correct_for_split(const SpringNetwork& net, const Eigen::Mat
 void NewtonStepper::request_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
   if (!m_refresh || m_refresh->busy()) return;
   const double wm = mass_weight(dt), wk = stiffness_weight(net, dt);
+  // With decoupled shadows the worker analyses the network as it is now (torn or not) first.
+  const bool reanalyse = active().split_room() == NetworkSystem::SplitRoom::decoupled_shadows;
   if (m_refresh->start(*m_systems[static_cast<std::size_t>(1 - m_active)], net, x, wm, wk, m_splits,
-                       m_tear_ready ? CellTangent::projected : CellTangent::exact)) {
+                       m_tear_ready ? CellTangent::projected : CellTangent::exact, reanalyse)) {
     m_job_call = m_calls;
     m_job_dt = dt;
     m_job_mass_weight = wm;
@@ -175,11 +184,17 @@ void NewtonStepper::collect_refresh(const SpringNetwork& net, const Eigen::Matri
   m_uncorrected = false;
   ++report.refreshes;
   // Splits made while it was computed: bound now, and corrected for.
-  if (result.tag < m_splits) {
-    active().bind_split_vertices(net);
+  if (result.tag < m_splits && !active().bind_split_vertices(net)) m_uncorrected = true;
+  if (active().split_room() == NetworkSystem::SplitRoom::decoupled_shadows) {
+    // Re-analysed: its own numbering of the dofs. The right-hand side's unused entries (the
+    // decoupled shadows') must be zero.
+    bind_free_entries(net);
+    m_r.setZero();
+    m_dx.setZero();
+  }
+  if (result.tag < m_splits)
     for (long index = result.tag + 1; index <= m_splits; ++index)
       if (!correct_for_split(net, x, index)) m_uncorrected = true;
-  }
 }
 
 void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
@@ -374,9 +389,13 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
     const int e = m_free_entry[static_cast<std::size_t>(k)];
     x.data()[e] += dt * v.data()[e];
   }
-  if (m_factor_dt < 0.0 || m_uncorrected) {
-    // Never primed, or a split the correction could not take (more splits than it holds before a
-    // refresh came): factorise here (the one factorisation a servo step may make).
+  // A split the correction could not take (more splits than it holds before a refresh came):
+  // with coupled shadows the torn network is factorised here, the one factorisation a servo step
+  // may make; with decoupled ones (which cannot be assembled torn without a new analysis) the
+  // iteration goes on with the factor as corrected so far while a fresh one is computed.
+  const bool refactor_here = m_factor_dt < 0.0 || (m_uncorrected && active().split_room() != NetworkSystem::SplitRoom::decoupled_shadows);
+  if (refactor_here) {
+    // Never primed, or uncorrected splits on coupled shadows: factorise here.
     if (m_refresh) {
       m_refresh->wait();
       if (m_refresh->busy()) m_refresh->collect(); // its system is about to be reused
@@ -386,7 +405,7 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
       return report;
     }
     ++report.factorisations;
-  } else if (m_factor_dt != dt || m_correction.splits() > 0) {
+  } else if (m_factor_dt != dt || m_correction.splits() > 0 || m_uncorrected) {
     // A new dt, or splits the kept factor is only corrected for: a fresh factor (if none is
     // being computed already).
     request_refresh(net, x, dt);

@@ -120,6 +120,8 @@ private:
   NetworkSystem& active() { return *m_systems[static_cast<std::size_t>(m_active)]; }
   /// Assembles and factorises the active system on the calling thread.
   bool refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
+  /// The room for vertex splits of a tear-ready stepper's systems.
+  [[nodiscard]] NetworkSystem::SplitRoom split_room() const;
   [[nodiscard]] double mass_weight(double dt) const;
   [[nodiscard]] double stiffness_weight(const SpringNetwork& net, double dt) const;
   /// Starts a refresh at positions x (if none is running).

@@ -10,7 +10,7 @@ constexpr int padding = 16; // the forward substitution's vectors have room for 
 } // namespace
 
 void SplitCorrection::reserve(int dofs) {
-  m_dofs = dofs;
+  m_capacity = m_dofs = dofs;
   m_f.assign(static_cast<std::size_t>(max_columns) * static_cast<std::size_t>(dofs + padding), 0.0f);
   m_ranges.assign(static_cast<std::size_t>(max_splits) * 2 * static_cast<std::size_t>(dofs + 1), 0);
   m_y_single.assign(static_cast<std::size_t>(dofs + padding), 0.0f);
@@ -38,7 +38,8 @@ void SplitCorrection::column_of_w(int split, int j, float* v) const noexcept {
 bool SplitCorrection::add(NetworkSystem& system, const SpringNetwork& net, const Eigen::Matrix3Xd& x, int original, int copy,
                           double mass_before, double mass_weight, double stiffness_weight, CellTangent tangent,
                           const NodePair* later, int later_count) noexcept {
-  if (full() || m_dofs != system.dof_count()) return false;
+  if (m_splits == 0) m_dofs = system.dof_count(); // a system of its own numbering since `clear`
+  if (full() || m_dofs != system.dof_count() || m_dofs > m_capacity) return false;
   const std::vector<int>& dof = system.dof_of();
   Split& s = m_split[m_splits];
   s = Split{};

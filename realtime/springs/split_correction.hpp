@@ -45,7 +45,8 @@ public:
   /// Other corners of the moved cells: at most the 26 neighbours of a lattice point.
   static constexpr int max_neighbours = 26;
 
-  /// Sizes the workspaces for a system of `dofs` unknowns (allocates).
+  /// Sizes the workspaces for systems of up to `dofs` unknowns (allocates). The first split after
+  /// `clear` takes the size of the system it corrects.
   void reserve(int dofs);
   /// No split pending: the kept factor is exact for the topology.
   void clear() noexcept { m_splits = 0; m_columns = 0; }
@@ -90,7 +91,8 @@ private:
   /// Column j of W (a split's unit column of S, or a column of V) into the dense float vector v.
   void column_of_w(int split, int j, float* v) const noexcept;
 
-  int m_dofs = 0;
+  int m_capacity = 0; ///< dofs the workspaces hold
+  int m_dofs = 0;     ///< dofs of the system corrected
   int m_splits = 0;
   int m_columns = 0;
   Split m_split[max_splits];

@@ -1,6 +1,8 @@
-// SplitCorrection: the kept factor of a tear-ready system, corrected for vertex splits made
-// after its matrix was assembled, solves like a fresh factorisation of the torn network's matrix
-// (the same state, the same tangent). The second method is that fresh factorisation.
+// SplitCorrection: the kept factor of a system with room for splits (coupled or decoupled
+// shadows), corrected for vertex splits made after its matrix was assembled, solves like a fresh
+// factorisation of the torn network's matrix (the same state, the same tangent). The second
+// method is that fresh factorisation. And a system with decoupled shadows analysed on a torn
+// network (what the factor refresh's worker builds) solves like the torn network's plain system.
 
 #include "tests/realtime/springs/network_fixtures.hpp"
 
@@ -10,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <string>
 
 namespace kerf {
 namespace {
@@ -45,23 +48,46 @@ Eigen::Matrix3Xd by_node(const NetworkSystem& system, const SpringNetwork& net, 
   return out;
 }
 
-TEST(SplitCorrection, KeptFactorCorrectedForSplitsSolvesLikeAFreshFactor) {
-  const double h = 2.5e-3, dt = 1e-3;
-  SpringNetwork net = test::full_block(4, h, identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0);
-  for (int n = 0; n < net.node_count; ++n)
-    if (test::grid_of(net, n).z() == 0) net.constraint[static_cast<std::size_t>(n)] = fix_all;
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Eigen::Matrix3Xd x = net.rest;
+/// A right-hand side given per node, in `system`'s numbering (zero on unused shadows).
+Eigen::VectorXd in_dofs(const NetworkSystem& system, const SpringNetwork& net, const Eigen::Matrix3Xd& b) {
+  Eigen::VectorXd out = Eigen::VectorXd::Zero(system.dof_count());
   for (int n = 0; n < net.node_count; ++n)
     for (int i = 0; i < 3; ++i)
-      if (!(net.constraint[static_cast<std::size_t>(n)] & (1u << i))) x(i, n) += 0.03 * h * u(rng);
-  const double wm = 1.0 / (dt * dt), wk = 1.02;
+      if (const int d = system.dof_of()[static_cast<std::size_t>(3 * n + i)]; d >= 0) out[d] = b(i, n);
+  return out;
+}
+
+/// A 4^3 clay block on its fixed base, its free nodes moved at random by 3 % of a cell.
+struct Block {
+  double h = 2.5e-3, dt = 1e-3;
+  SpringNetwork net;
+  Eigen::Matrix3Xd x;
+  Block() : net(test::full_block(4, h, identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0)) {
+    for (int n = 0; n < net.node_count; ++n)
+      if (test::grid_of(net, n).z() == 0) net.constraint[static_cast<std::size_t>(n)] = fix_all;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    x = net.rest;
+    for (int n = 0; n < net.node_count; ++n)
+      for (int i = 0; i < 3; ++i)
+        if (!(net.constraint[static_cast<std::size_t>(n)] & (1u << i))) x(i, n) += 0.03 * h * u(rng);
+  }
+};
+
+class SplitCorrectionIn : public testing::TestWithParam<NetworkSystem::SplitRoom> {};
+
+TEST_P(SplitCorrectionIn, KeptFactorCorrectedForSplitsSolvesLikeAFreshFactor) {
+  const Block block;
+  const SpringNetwork& net = block.net;
+  const Eigen::Matrix3Xd& x = block.x;
+  const double wm = 1.0 / (block.dt * block.dt), wk = 1.02;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
   for (const CellTangent tangent : {CellTangent::projected, CellTangent::exact}) {
     SpringNetwork torn = net;
     Eigen::Matrix3Xd xt = x;
     NetworkSystem kept(NetworkSystem::SolvePrecision::single_precision);
-    kept.rebuild(torn, true);
+    kept.rebuild(torn, GetParam());
     kept.assemble(torn, xt, wm, wk, tangent);
     ASSERT_TRUE(kept.factorize());
     // Corrected as each split is made, and (a factor adopted after both) for both afterwards,
@@ -86,20 +112,22 @@ TEST(SplitCorrection, KeptFactorCorrectedForSplitsSolvesLikeAFreshFactor) {
     EXPECT_EQ(correction.splits(), 2);
     ASSERT_TRUE(afterwards.add(kept, torn, xt, made[0].original, made[0].copy, before[0], wm, wk, tangent, &made[1], 1));
     ASSERT_TRUE(afterwards.add(kept, torn, xt, made[1].original, made[1].copy, before[1], wm, wk, tangent));
+    // With decoupled shadows the system cannot be assembled torn until it is analysed again.
+    if (GetParam() == NetworkSystem::SplitRoom::decoupled_shadows) EXPECT_FALSE(kept.factorize());
     // The fresh factor of the torn network at the same state (its own tear-ready analysis).
     NetworkSystem fresh(NetworkSystem::SolvePrecision::single_precision);
     fresh.rebuild(net, true);
     ASSERT_TRUE(fresh.bind_split_vertices(torn));
     fresh.assemble(torn, xt, wm, wk, tangent);
     ASSERT_TRUE(fresh.factorize());
-    Eigen::VectorXd b = Eigen::VectorXd::Zero(fresh.dof_count());
+    Eigen::Matrix3Xd b_node(3, torn.node_count);
     for (int n = 0; n < torn.node_count; ++n)
-      for (int i = 0; i < 3; ++i)
-        if (const int d = fresh.dof_of()[static_cast<std::size_t>(3 * n + i)]; d >= 0) b[d] = u(rng);
+      for (int i = 0; i < 3; ++i) b_node(i, n) = u(rng);
+    const Eigen::VectorXd b = in_dofs(kept, torn, b_node), bf = in_dofs(fresh, torn, b_node);
     Eigen::VectorXd a(kept.dof_count()), e(fresh.dof_count()), plain(kept.dof_count()), late(kept.dof_count());
     correction.solve(kept, b, a);
     afterwards.solve(kept, b, late);
-    fresh.solve(b, e);
+    fresh.solve(bf, e);
     kept.solve(b, plain);
     const Eigen::Matrix3Xd corrected = by_node(kept, torn, a), expected = by_node(fresh, torn, e),
                            uncorrected = by_node(kept, torn, plain), corrected_late = by_node(kept, torn, late);
@@ -110,6 +138,58 @@ TEST(SplitCorrection, KeptFactorCorrectedForSplitsSolvesLikeAFreshFactor) {
     // and the correction matters: the kept factor alone is off by far more.
     EXPECT_GT((uncorrected - expected).cwiseAbs().maxCoeff(), 1e-2 * scale);
   }
+}
+
+INSTANTIATE_TEST_SUITE_P(Room, SplitCorrectionIn,
+                         testing::Values(NetworkSystem::SplitRoom::coupled_shadows, NetworkSystem::SplitRoom::decoupled_shadows),
+                         [](const testing::TestParamInfo<NetworkSystem::SplitRoom>& info) {
+                           return info.param == NetworkSystem::SplitRoom::coupled_shadows ? std::string("CoupledShadows")
+                                                                                          : std::string("DecoupledShadows");
+                         });
+
+TEST(SplitRoom, DecoupledShadowsOfATornNetworkSolveLikeItsOwnSystemAndStayOutOfTheFactor) {
+  // What the factor refresh's worker builds: a torn network analysed again with decoupled
+  // shadows, against the same torn network's plain system (no room), in double precision.
+  Block block;
+  SpringNetwork& torn = block.net;
+  const int copy = torn.node_count;
+  const int original = split_at(torn, Eigen::Vector3i(2, 2, 2), 0);
+  ASSERT_GE(original, 0);
+  block.x.col(copy) = block.x.col(original);
+  const double wm = 1.0 / (block.dt * block.dt), wk = 1.02;
+  NetworkSystem room, plain;
+  room.rebuild(torn, NetworkSystem::SplitRoom::decoupled_shadows);
+  plain.rebuild(torn, NetworkSystem::SplitRoom::none);
+  // The split pair has no shadow (a vertex splits once), every other free node one.
+  int free_dofs = 0, free_dofs_alone = 0;
+  for (int n = 0; n < torn.node_count; ++n)
+    for (int i = 0; i < 3; ++i)
+      if (!(torn.constraint[static_cast<std::size_t>(n)] & (1u << i))) {
+        ++free_dofs;
+        free_dofs_alone += n == original || n == copy ? 0 : 1;
+      }
+  EXPECT_EQ(plain.dof_count(), free_dofs);
+  EXPECT_EQ(room.factor_dofs(), free_dofs);
+  EXPECT_EQ(room.dof_count(), free_dofs + free_dofs_alone);
+  // The factor is the torn network's own: as many entries as the plain one's, plus one per shadow.
+  EXPECT_EQ(room.factor_entries(), plain.factor_entries() + free_dofs_alone);
+  for (NetworkSystem* s : {&room, &plain}) {
+    s->assemble(torn, block.x, wm, wk, CellTangent::exact);
+    ASSERT_TRUE(s->factorize());
+  }
+  Eigen::Matrix3Xd b_node(3, torn.node_count);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int n = 0; n < torn.node_count; ++n)
+    for (int i = 0; i < 3; ++i) b_node(i, n) = u(rng);
+  const Eigen::VectorXd b = in_dofs(room, torn, b_node), bp = in_dofs(plain, torn, b_node);
+  Eigen::VectorXd a(room.dof_count()), e(plain.dof_count());
+  room.solve(b, a);
+  plain.solve(bp, e);
+  const Eigen::Matrix3Xd got = by_node(room, torn, a), expected = by_node(plain, torn, e);
+  EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-10 * expected.cwiseAbs().maxCoeff());
+  // An unused shadow's equation is decoupled with a zero right-hand side: its solution is zero.
+  for (int d = room.factor_dofs(); d < room.dof_count(); ++d) EXPECT_EQ(a[d], 0.0);
 }
 
 } // namespace
