@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace kerf {
@@ -45,24 +46,114 @@ VertexTearing::VertexTearing(const SpringNetwork& net, double tensile_limit) : m
   m_stress.assign(static_cast<std::size_t>(net.node_capacity()), Eigen::Matrix3d::Zero());
   m_cells.assign(static_cast<std::size_t>(net.node_capacity()), 0);
   m_opened.assign(static_cast<std::size_t>(net.node_capacity()), 0);
+  const auto springs = 28 * static_cast<std::size_t>(net.cell_count());
+  m_spring_of.assign(springs, 0);
+  m_shared.assign(springs, {0, 0, 0});
+  m_term.assign(springs, Eigen::Matrix3d::Zero());
+  m_apart.assign(springs, 0);
+  m_pairing.assign(springs, {0, 0});
+  share_springs(net);
 }
 
-bool VertexTearing::tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
-                         const std::vector<std::uint8_t>& excluded) noexcept {
+void VertexTearing::share_springs(const SpringNetwork& net) noexcept {
+  // Key (a, b, kind) with a < b packed as merge_springs packs it, beside the cell spring's index.
+  std::size_t m = 0;
+  for (const auto& nodes : net.cell_nodes)
+    for (const CellSpring& cs : cell_springs) {
+      const auto p = static_cast<std::uint64_t>(nodes[static_cast<std::size_t>(cs.a)]);
+      const auto q = static_cast<std::uint64_t>(nodes[static_cast<std::size_t>(cs.b)]);
+      m_pairing[m] = {(std::min(p, q) << 34) | (std::max(p, q) << 4) | static_cast<std::uint64_t>(cs.type), static_cast<int>(m)};
+      ++m;
+    }
+  std::sort(m_pairing.begin(), m_pairing.begin() + static_cast<std::ptrdiff_t>(m));
+  m_shared_count = 0;
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::uint64_t key = m_pairing[i].first;
+    if (i == 0 || key != m_pairing[i - 1].first)
+      m_shared[static_cast<std::size_t>(m_shared_count++)] = {static_cast<int>(key >> 34),
+                                                              static_cast<int>((key >> 4) & ((std::uint64_t{1} << 30) - 1)),
+                                                              static_cast<int>(key & 15u)};
+    m_spring_of[static_cast<std::size_t>(m_pairing[i].second)] = m_shared_count - 1;
+  }
+  m_topology = net.topology;
+}
+
+void VertexTearing::share_springs_after_split(const SpringNetwork& net, int copy) noexcept {
+  // Only the springs at the copy changed (their cells moved to it); they are shared among the
+  // moved cells alone. A spring that no cell uses any more keeps its slot (computed, unread).
+  const int first = m_shared_count;
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(c)];
+    for (int k = 0; k < 28; ++k) {
+      const CellSpring& cs = cell_springs[static_cast<std::size_t>(k)];
+      const int p = nodes[static_cast<std::size_t>(cs.a)], q = nodes[static_cast<std::size_t>(cs.b)];
+      if (p != copy && q != copy) continue;
+      const std::array<int, 3> spring{std::min(p, q), std::max(p, q), cs.type};
+      int id = first;
+      while (id < m_shared_count && m_shared[static_cast<std::size_t>(id)] != spring) ++id;
+      if (id == m_shared_count) {
+        if (m_shared_count == static_cast<int>(m_shared.size())) { // no slot left: pair them all again
+          share_springs(net);
+          return;
+        }
+        m_shared[static_cast<std::size_t>(m_shared_count++)] = spring;
+      }
+      m_spring_of[static_cast<std::size_t>(28 * c + k)] = id;
+    }
+  }
+  m_topology = net.topology;
+}
+
+void VertexTearing::sum_cell_stresses(const SpringNetwork& net, const Eigen::Matrix3Xd& x) noexcept {
+  if (net.topology != m_topology) share_springs(net); // cells changed other than by `tear`
+  const double h = net.block.cell_size;
+  const double V0 = h * h * h;
+  // Each shared spring's term, the numbers cell_stress adds for it: Eigen evaluates its
+  // `σ += c (e eᵀ)` entry by entry as (c e_i) e_j. A spring's term is the same for e and −e, so a
+  // cell that runs the spring the other way adds the same numbers.
+  const double k[4] = {0.0, net.spring_constant(1), net.spring_constant(2), net.spring_constant(3)};
+  const double L[4] = {0.0, net.rest_length(1), net.rest_length(2), net.rest_length(3)};
+  for (int u = 0; u < m_shared_count; ++u) {
+    const auto& [a, b, type] = m_shared[static_cast<std::size_t>(u)];
+    const Eigen::Vector3d e = x.col(b) - x.col(a);
+    const double l = e.norm();
+    m_apart[static_cast<std::size_t>(u)] = l > 0.0 ? 1 : 0;
+    if (!(l > 0.0)) continue;
+    const double c = k[type] * (l - L[type]) / (l * V0);
+    const double ce[3] = {c * e[0], c * e[1], c * e[2]};
+    double* term = m_term[static_cast<std::size_t>(u)].data(); // column-major: (i, j) at i + 3 j
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) term[i + 3 * j] = ce[i] * e[j];
+  }
   const int n = net.node_count;
   for (int p = 0; p < n; ++p) {
     m_stress[static_cast<std::size_t>(p)].setZero();
     m_cells[static_cast<std::size_t>(p)] = 0;
   }
   Eigen::Matrix<double, 3, 8> xc;
-  for (const auto& nodes : net.cell_nodes) {
-    for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
-    const Eigen::Matrix3d sigma = cell_stress(net, xc);
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(c)];
+    // cell_stress: the springs' terms in cell_springs' order, then the volume term.
+    Eigen::Matrix3d sigma = Eigen::Matrix3d::Zero();
+    const int* of = m_spring_of.data() + 28 * static_cast<std::size_t>(c);
+    for (int j = 0; j < 28; ++j)
+      if (m_apart[static_cast<std::size_t>(of[j])]) sigma += m_term[static_cast<std::size_t>(of[j])];
+    if (net.stiffness.volume_modulus > 0.0) {
+      for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
+      sigma.diagonal().array() += net.stiffness.volume_modulus * (cell_deformation_gradient(xc, h).determinant() - 1.0);
+    }
     for (int id : nodes) {
       m_stress[static_cast<std::size_t>(id)] += sigma;
       ++m_cells[static_cast<std::size_t>(id)];
     }
   }
+}
+
+bool VertexTearing::tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
+                         const std::vector<std::uint8_t>& excluded) noexcept {
+  const int n = net.node_count;
+  sum_cell_stresses(net, x);
+  Eigen::Matrix<double, 3, 8> xc;
   // The vertex stress: the mean of its cells' stresses; σ₁ its largest principal value.
   int worst = -1;
   double worst_stress = -INFINITY;
@@ -133,6 +224,7 @@ bool VertexTearing::tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3
   net.mass[static_cast<std::size_t>(worst)] = (total_cells - moved) * net.cell_mass / 8.0;
   m_opened[static_cast<std::size_t>(worst)] = m_opened[static_cast<std::size_t>(copy)] = 1;
   merge_springs(net);
+  share_springs_after_split(net, copy);
   return true;
 }
 

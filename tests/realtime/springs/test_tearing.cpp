@@ -105,5 +105,52 @@ TEST(Tearing, ClayTearSplitsIntoTwoPiecesThatKeepTheVolume) {
   EXPECT_GT(smallest_volume(torn.mesh, deformed), 0.0);
 }
 
+TEST(Tearing, VertexStressesAreTheSumsOfTheCellStressesOnATornNetwork) {
+  // VertexTearing sums each node's cell stresses with every spring's term computed once for the
+  // cells that share it; the second method is cell_stress cell by cell (the same numbers, to the
+  // bit). On clay_tear's network torn part way (its copies share no spring with their
+  // originals' other cells), through further splits (the sharing updated split by split).
+  const TetMesh mesh = test::clay_tear_mesh();
+  SpringNetworkModel model(mesh, test::clay_tear_setup(SpringIntegrator::implicit_euler));
+  std::array<ToolState, 2> tools;
+  std::array<ForceSample, 2> forces;
+  for (int k = 0; k <= 2000 && model.tears() < 20; ++k) {
+    tools[0].position = {0.015 - 5e-6 * k, 0.0, 0.022};
+    tools[1].position = {0.045 + 5e-6 * k, 0.0, 0.022};
+    model.step(tools, 1e-3, forces);
+  }
+  ASSERT_GE(model.tears(), 20);
+  SpringNetwork net = model.network();
+  Eigen::Matrix3Xd x = model.positions();
+  Eigen::Matrix3Xd v = Eigen::Matrix3Xd::Zero(3, net.node_capacity());
+  // The right half moved 1 mm further along the bar, so that the cells right of the middle
+  // plane are stretched by a fifth and its vertices split, one a call.
+  for (int p = 0; p < net.node_count; ++p)
+    if (net.rest(0, p) > 0.031) x(0, p) += 1e-3;
+  // The vertices split already (a copy and its original share a rest position) split no more.
+  std::vector<std::uint8_t> excluded(static_cast<std::size_t>(net.node_capacity()), 0);
+  for (int p = 0; p < net.node_count; ++p)
+    for (int q = p + 1; q < net.node_count; ++q)
+      if (net.rest.col(p) == net.rest.col(q)) excluded[static_cast<std::size_t>(p)] = excluded[static_cast<std::size_t>(q)] = 1;
+  VertexTearing tearing(net, 50e3);
+  int splits = 0;
+  for (int call = 0; call < 6; ++call) {
+    const SpringNetwork before = net;
+    const bool split = tearing.tear(net, x, v, excluded);
+    splits += split ? 1 : 0;
+    std::vector<Eigen::Matrix3d> expected(static_cast<std::size_t>(before.node_count), Eigen::Matrix3d::Zero());
+    Eigen::Matrix<double, 3, 8> xc;
+    for (const auto& nodes : before.cell_nodes) {
+      for (int a = 0; a < 8; ++a) xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
+      const Eigen::Matrix3d sigma = cell_stress(before, xc);
+      for (const int id : nodes) expected[static_cast<std::size_t>(id)] += sigma;
+    }
+    for (int p = 0; p < before.node_count; ++p)
+      for (int e = 0; e < 9; ++e)
+        ASSERT_EQ(tearing.cell_stress_sum(p).data()[e], expected[static_cast<std::size_t>(p)].data()[e]) << "call " << call << ", node " << p;
+  }
+  EXPECT_GE(splits, 3) << "largest vertex stress " << tearing.last_max_stress() << " Pa"; // the sharing was updated after splits, not only built
+}
+
 } // namespace
 } // namespace kerf
