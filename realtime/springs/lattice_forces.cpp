@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace kerf {
 
@@ -415,6 +416,49 @@ void lattice_update_single(int n, double h, const double* __restrict W, const do
   }
 }
 
+/// One lattice direction's springs, start points p in [begin, end), in each precision's kernels:
+/// the end points' share in the same loop where |o| is at least the widest SIMD width of the
+/// precision (8 doubles, 16 floats: then no two lanes of one vector touch the same point), else
+/// through G and direction_ends. Double: absolute positions X; single: displacements U from the
+/// rest lattice with the direction's rest vector (ox, oy, oz) = h o_d. Returns the elastic energy.
+double direction_forces(int begin, int end, int o, const std::array<double, 3>& /*offset*/, double rest, double tau, double tiny,
+                        const double* k, const double* X, const double* V, double* F, double* G, int P) noexcept {
+  if (std::abs(o) >= 8)
+    return direction_springs_fused(begin, end, o, rest, tau, tiny, k, X, X + P, X + 2 * P, V, V + P, V + 2 * P, F, F + P, F + 2 * P);
+  const double energy =
+      direction_springs(begin, end, o, rest, tau, tiny, k, X, X + P, X + 2 * P, V, V + P, V + 2 * P, F, F + P, F + 2 * P, G, G + P, G + 2 * P);
+  direction_ends(begin, end, o, G, G + P, G + 2 * P, F, F + P, F + 2 * P);
+  return energy;
+}
+float direction_forces(int begin, int end, int o, const std::array<float, 3>& offset, float rest, float tau, float tiny, const float* k,
+                       const float* U, const float* V, float* F, float* G, int P) noexcept {
+  if (std::abs(o) >= 16)
+    return direction_springs_single_fused(begin, end, o, offset[0], offset[1], offset[2], rest, tau, tiny, k, U, U + P, U + 2 * P, V,
+                                          V + P, V + 2 * P, F, F + P, F + 2 * P);
+  const float energy = direction_springs_single(begin, end, o, offset[0], offset[1], offset[2], rest, tau, tiny, k, U, U + P, U + 2 * P, V,
+                                                V + P, V + 2 * P, F, F + P, F + 2 * P, G, G + P, G + 2 * P);
+  direction_ends_single(begin, end, o, G, G + P, G + 2 * P, F, F + P, F + 2 * P);
+  return energy;
+}
+
+/// The cells' volume term in each precision's kernels (cell_volumes, cell_volumes_single), then
+/// each point's share of its cells' corner forces; returns the cells' energy.
+double volume_forces(int P, int pad, const int* corner, double c, double kappa_v0, double tau, const double* cell, const double* X,
+                     const double* V, double* Q, double* F) noexcept {
+  const int stride = pad + P;
+  const double energy = cell_volumes(P - pad, corner, c, kappa_v0, tau, cell, X, X + P, X + 2 * P, V, V + P, V + 2 * P, Q, stride, pad);
+  cell_volume_forces(P, corner, Q, stride, pad, F, F + P, F + 2 * P);
+  return energy;
+}
+float volume_forces(int P, int pad, const int* corner, float c, float kappa_v0, float tau, const float* cell, const float* U,
+                    const float* V, float* Q, float* F) noexcept {
+  const int stride = pad + P;
+  const float energy =
+      cell_volumes_single(P - pad, corner, c, kappa_v0, tau, cell, U, U + P, U + 2 * P, V, V + P, V + 2 * P, Q, stride, pad);
+  cell_volume_forces_single(P, corner, Q, stride, pad, F, F + P, F + 2 * P);
+  return energy;
+}
+
 } // namespace
 
 LatticeForces::LatticeForces(const SpringNetwork& net) {
@@ -583,57 +627,6 @@ double LatticeForces::substep(const SpringNetwork& net, double h, ForcePrecision
   return energy;
 }
 
-double LatticeForces::lattice_forces_single(const SpringNetwork& net) noexcept {
-  const int P = m_points;
-  const float* U = m_u_single.data();
-  const float* V = m_v_single.data();
-  float* F = m_f_single.data();
-  float* G = m_g_single.data();
-  std::fill(m_f_single.begin(), m_f_single.end(), 0.0f);
-  const double h = net.block.cell_size;
-  const auto tau = static_cast<float>(net.damping_time);
-  const auto tiny = static_cast<float>(1e-12 * h);
-  double energy = 0.0;
-  for (std::size_t d = 0; d < directions.size(); ++d) {
-    const int o = m_offset[d];
-    const int begin = std::max(0, -o), end = P - std::max(0, o);
-    if (std::abs(o) >= 16) { // the end points' share in the same loop
-      energy += direction_springs_single_fused(
-          begin, end, o, static_cast<float>(h * directions[d][0]), static_cast<float>(h * directions[d][1]),
-          static_cast<float>(h * directions[d][2]), static_cast<float>(net.rest_length(m_type[d])), tau, tiny,
-          m_k_single.data() + d * static_cast<std::size_t>(P), U, U + P, U + 2 * P, V, V + P, V + 2 * P, F, F + P, F + 2 * P);
-      continue;
-    }
-    energy += direction_springs_single(begin, end, o, static_cast<float>(h * directions[d][0]), static_cast<float>(h * directions[d][1]),
-                                       static_cast<float>(h * directions[d][2]), static_cast<float>(net.rest_length(m_type[d])), tau,
-                                       tiny, m_k_single.data() + d * static_cast<std::size_t>(P), U, U + P, U + 2 * P, V, V + P,
-                                       V + 2 * P, F, F + P, F + 2 * P, G, G + P, G + 2 * P);
-    direction_ends_single(begin, end, o, G, G + P, G + 2 * P, F, F + P, F + 2 * P);
-  }
-  const double kappa = net.stiffness.volume_modulus;
-  if (kappa > 0.0) {
-    const int stride = m_pad + P;
-    energy += cell_volumes_single(P - m_pad, m_corner.data(), static_cast<float>(1.0 / (4.0 * h)), static_cast<float>(kappa * h * h * h),
-                                  tau, m_cell_single.data(), U, U + P, U + 2 * P, V, V + P, V + 2 * P, m_q_single.data(), stride,
-                                  m_pad);
-    cell_volume_forces_single(P, m_corner.data(), m_q_single.data(), stride, m_pad, F, F + P, F + 2 * P);
-  }
-  // The anchors (a compliant grasp): f = K (a − x) + τ K (ȧ − v), with a − x = (a − X) − u from
-  // the single-precision displacement u, the difference taken in double.
-  const NodeAnchors& anchors = net.anchors;
-  for (int i = 0; i < anchors.count(); ++i) {
-    const int s = m_slot[static_cast<std::size_t>(anchors.node[static_cast<std::size_t>(i)])];
-    const double K = anchors.stiffness[static_cast<std::size_t>(i)];
-    for (int r = 0; r < 3; ++r) {
-      const auto e = static_cast<std::size_t>(r * P + s);
-      const double gap = (anchors.position(r, i) - m_rest[e]) - static_cast<double>(U[e]);
-      F[e] += static_cast<float>(K * (gap + net.damping_time * (anchors.velocity(r, i) - static_cast<double>(V[e]))));
-      energy += 0.5 * K * gap * gap;
-    }
-  }
-  return energy;
-}
-
 double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                                Eigen::Matrix3Xd& f, ForcePrecision precision) noexcept {
   if (!applies(net)) return network_forces(net, x, v, f);
@@ -689,50 +682,64 @@ double LatticeForces::gershgorin_bound(const SpringNetwork& net, const Eigen::Ma
   return bound;
 }
 
-double LatticeForces::lattice_forces(const SpringNetwork& net) noexcept {
+template <class Real>
+double LatticeForces::lattice_forces_in(const SpringNetwork& net) noexcept {
+  constexpr bool single = std::is_same_v<Real, float>;
+  // The state each precision reads (double: positions; single: displacements from the rest
+  // lattice) and the planes it writes.
+  const Real* X = nullptr;
+  const Real* V = nullptr;
+  const Real* K = nullptr;
+  const Real* cell = nullptr;
+  Real *F = nullptr, *G = nullptr, *Q = nullptr;
+  if constexpr (single) {
+    X = m_u_single.data(), V = m_v_single.data(), K = m_k_single.data(), cell = m_cell_single.data();
+    F = m_f_single.data(), G = m_g_single.data(), Q = m_q_single.data();
+    std::fill(m_f_single.begin(), m_f_single.end(), 0.0f);
+  } else {
+    X = m_x.data(), V = m_v.data(), K = m_k.data(), cell = m_cell.data();
+    F = m_f.data(), G = m_g.data(), Q = m_q.data();
+    std::fill(m_f.begin(), m_f.end(), 0.0);
+  }
   const int P = m_points;
-  double* X = m_x.data();
-  double* V = m_v.data();
-  double* F = m_f.data();
-  double* G = m_g.data();
-  std::fill(m_f.begin(), m_f.end(), 0.0);
-  const double tau = net.damping_time;
-  const double tiny = 1e-12 * net.block.cell_size;
+  const double h = net.block.cell_size;
+  const auto tau = static_cast<Real>(net.damping_time);
+  const auto tiny = static_cast<Real>(1e-12 * h);
   double energy = 0.0;
   for (std::size_t d = 0; d < directions.size(); ++d) {
     const int o = m_offset[d];
     const int begin = std::max(0, -o), end = P - std::max(0, o);
-    if (std::abs(o) >= 8) { // the end points' share in the same loop
-      energy += direction_springs_fused(begin, end, o, net.rest_length(m_type[d]), tau, tiny,
-                                        m_k.data() + d * static_cast<std::size_t>(P), X, X + P, X + 2 * P, V, V + P, V + 2 * P, F,
-                                        F + P, F + 2 * P);
-      continue;
-    }
-    energy += direction_springs(begin, end, o, net.rest_length(m_type[d]), tau, tiny, m_k.data() + d * static_cast<std::size_t>(P),
-                                X, X + P, X + 2 * P, V, V + P, V + 2 * P, F, F + P, F + 2 * P, G, G + P, G + 2 * P);
-    direction_ends(begin, end, o, G, G + P, G + 2 * P, F, F + P, F + 2 * P);
+    const std::array<Real, 3> offset{static_cast<Real>(h * directions[d][0]), static_cast<Real>(h * directions[d][1]),
+                                     static_cast<Real>(h * directions[d][2])};
+    energy += direction_forces(begin, end, o, offset, static_cast<Real>(net.rest_length(m_type[d])), tau, tiny,
+                               K + d * static_cast<std::size_t>(P), X, V, F, G, P);
   }
   const double kappa = net.stiffness.volume_modulus;
-  if (kappa > 0.0) {
-    const double h = net.block.cell_size;
-    const int stride = m_pad + P;
-    energy += cell_volumes(P - m_pad, m_corner.data(), 1.0 / (4.0 * h), kappa * h * h * h, tau, m_cell.data(), X, X + P,
-                           X + 2 * P, V, V + P, V + 2 * P, m_q.data(), stride, m_pad);
-    cell_volume_forces(P, m_corner.data(), m_q.data(), stride, m_pad, F, F + P, F + 2 * P);
-  }
-  // The anchors (a compliant grasp): f = K (a − x) + τ K (ȧ − v).
+  if (kappa > 0.0)
+    energy += volume_forces(P, m_pad, m_corner.data(), static_cast<Real>(1.0 / (4.0 * h)), static_cast<Real>(kappa * h * h * h), tau,
+                            cell, X, V, Q, F);
+  // The anchors (a compliant grasp): f = K (a − x) + τ K (ȧ − v); in single precision a − x =
+  // (a − X) − u from the displacement u, the difference taken in double.
   const NodeAnchors& anchors = net.anchors;
   for (int i = 0; i < anchors.count(); ++i) {
     const int s = m_slot[static_cast<std::size_t>(anchors.node[static_cast<std::size_t>(i)])];
-    const double K = anchors.stiffness[static_cast<std::size_t>(i)];
+    const double stiffness = anchors.stiffness[static_cast<std::size_t>(i)];
     for (int r = 0; r < 3; ++r) {
       const auto e = static_cast<std::size_t>(r * P + s);
-      const double gap = anchors.position(r, i) - X[e];
-      F[e] += K * (gap + tau * (anchors.velocity(r, i) - V[e]));
-      energy += 0.5 * K * gap * gap;
+      double gap = 0.0;
+      if constexpr (single)
+        gap = (anchors.position(r, i) - m_rest[e]) - static_cast<double>(X[e]);
+      else
+        gap = anchors.position(r, i) - X[e];
+      F[e] += static_cast<Real>(stiffness * (gap + net.damping_time * (anchors.velocity(r, i) - static_cast<double>(V[e]))));
+      energy += 0.5 * stiffness * gap * gap;
     }
   }
   return energy;
 }
+
+double LatticeForces::lattice_forces(const SpringNetwork& net) noexcept { return lattice_forces_in<double>(net); }
+
+double LatticeForces::lattice_forces_single(const SpringNetwork& net) noexcept { return lattice_forces_in<float>(net); }
 
 } // namespace kerf

@@ -86,6 +86,12 @@ private:
   void gather_double(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
   void gather_single(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept;
   /// Forces of the gathered state into the lattice force planes; returns the elastic energy.
+  /// One pass for both precisions (`lattice_forces_in`): Real = double reads the positions into
+  /// m_f, Real = float the single-precision displacements into m_f_single; the direction and
+  /// volume kernels are each precision's own (the float ones on displacements, without
+  /// cancellation).
+  template <class Real>
+  double lattice_forces_in(const SpringNetwork& net) noexcept;
   double lattice_forces(const SpringNetwork& net) noexcept;
   /// The same in single precision, from the single-precision copies into m_f_single.
   double lattice_forces_single(const SpringNetwork& net) noexcept;
