@@ -32,6 +32,18 @@ struct CellGradient {
     default: return c * ((W[p + o4] - W[p]) + (W[p + o5] - W[p + o1]) + (W[p + o6] - W[p + o2]) + (W[p + o7] - W[p + o3]));
     }
   }
+  /// F's first column a = (ax, ay, az) and cof(F) = [b × d, d × a, a × b] (columns c0, c1, c2),
+  /// F's columns a (i = 0), b (1), d (2) read from the position planes X, Y, Z (rows x, y, z).
+  struct Cofactor {
+    double ax, ay, az, c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z;
+  };
+  [[gnu::always_inline]] Cofactor cofactor(const double* __restrict X, const double* __restrict Y, const double* __restrict Z, int p) const {
+    const double ax = column(X, p, 0), ay = column(Y, p, 0), az = column(Z, p, 0);
+    const double bx = column(X, p, 1), by = column(Y, p, 1), bz = column(Z, p, 1);
+    const double dx = column(X, p, 2), dy = column(Y, p, 2), dz = column(Z, p, 2);
+    return {ax, ay, az, by * dz - bz * dy, bz * dx - bx * dz, bx * dy - by * dx, dy * az - dz * ay, dz * ax - dx * az, dx * ay - dy * ax,
+            ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx};
+  }
 };
 
 /// One spring's force on its start point p and its elastic energy: the spring from p to q.
@@ -264,14 +276,7 @@ double cell_volumes(int end, const int* corner, double c, double kappa_v0, doubl
   const CellGradient cell{corner, c};
 #pragma omp simd reduction(+ : energy)
   for (int p = 0; p < end; ++p) {
-    // F columns a (i = 0), b (1), d (2); rows x, y, z.
-    const double ax = cell.column(X, p, 0), ay = cell.column(Y, p, 0), az = cell.column(Z, p, 0);
-    const double bx = cell.column(X, p, 1), by = cell.column(Y, p, 1), bz = cell.column(Z, p, 1);
-    const double dx = cell.column(X, p, 2), dy = cell.column(Y, p, 2), dz = cell.column(Z, p, 2);
-    // cof(F) = [b × d, d × a, a × b]
-    const double c0x = by * dz - bz * dy, c0y = bz * dx - bx * dz, c0z = bx * dy - by * dx;
-    const double c1x = dy * az - dz * ay, c1y = dz * ax - dx * az, c1z = dx * ay - dy * ax;
-    const double c2x = ay * bz - az * by, c2y = az * bx - ax * bz, c2z = ax * by - ay * bx;
+    const auto [ax, ay, az, c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z] = cell.cofactor(X, Y, Z, p);
     const double J = ax * c0x + ay * c0y + az * c0z;
     const double J_rate = c0x * cell.column(VX, p, 0) + c0y * cell.column(VY, p, 0) + c0z * cell.column(VZ, p, 0) +
                           c1x * cell.column(VX, p, 1) + c1y * cell.column(VY, p, 1) + c1z * cell.column(VZ, p, 1) +
@@ -350,13 +355,8 @@ void cell_rows(int end, const int* corner, double c, double kappa_v0, const doub
   const CellGradient cell{corner, c};
 #pragma omp simd
   for (int p = 0; p < end; ++p) {
-    const double ax = cell.column(X, p, 0), ay = cell.column(Y, p, 0), az = cell.column(Z, p, 0);
-    const double bx = cell.column(X, p, 1), by = cell.column(Y, p, 1), bz = cell.column(Z, p, 1);
-    const double dx = cell.column(X, p, 2), dy = cell.column(Y, p, 2), dz = cell.column(Z, p, 2);
-    // cof(F) = [b × d, d × a, a × b]; cof(F) s_a = Σ_i s_a[i] cof_i
-    const double c0x = by * dz - bz * dy, c0y = bz * dx - bx * dz, c0z = bx * dy - by * dx;
-    const double c1x = dy * az - dz * ay, c1y = dz * ax - dx * az, c1z = dx * ay - dy * ax;
-    const double c2x = ay * bz - az * by, c2y = az * bx - ax * bz, c2z = ax * by - ay * bx;
+    // cof(F) s_a = Σ_i s_a[i] cof_i
+    const auto [ax, ay, az, c0x, c0y, c0z, c1x, c1y, c1z, c2x, c2y, c2z] = cell.cofactor(X, Y, Z, p);
     double n[8];
     double total = 0.0;
     for (int a = 0; a < 8; ++a) {
