@@ -556,17 +556,8 @@ bool LatticeForces::applies(const SpringNetwork& net) const noexcept {
 }
 
 void LatticeForces::gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
-  const int P = m_points;
-  for (int p = 0; p < m_node_count; ++p) {
-    const int s = m_slot[static_cast<std::size_t>(p)];
-    for (int r = 0; r < 3; ++r) {
-      const auto e = static_cast<std::size_t>(r * P + s);
-      m_x[e] = x(r, p);
-      m_v[e] = v(r, p);
-      m_u_single[e] = static_cast<float>(x(r, p) - m_rest[e]);
-      m_v_single[e] = static_cast<float>(v(r, p));
-    }
-  }
+  gather_double(x, v);
+  gather_single(x, v);
 }
 
 void LatticeForces::gather_double(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
