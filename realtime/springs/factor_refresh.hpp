@@ -5,8 +5,8 @@
 // corners, masses and constraints that a tear changes) and a NetworkSystem it does not touch
 // until the job is collected; the worker binds the snapshot's vertex splits into that system
 // (or, asked to re-analyse, rebuilds it for the network as it is, with decoupled shadows:
-// allocation on the worker's side only), assembles A = w_m M + w_k K(x) with the exact tangent (the derivative of the forces) or the
-// projected one as asked, an exact A that is not positive definite (a buckling spring, a
+// allocation on the worker's side only), assembles A = w_m M + w_k K(x) with the exact tangent
+// (the derivative of the forces) or the projected one as asked, an exact A that is not positive definite (a buckling spring, a
 // collapsing cell) with the projected one instead, and factorises it.
 //
 // Handing over and collecting are lock-free and allocation-free on the servo thread: the

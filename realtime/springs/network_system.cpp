@@ -54,8 +54,9 @@ FreeDofs number_free_dofs(const SpringNetwork& net, NetworkSystem::SplitRoom roo
     for (int i = 0; i < 3; ++i)
       if (!(net.constraint[static_cast<std::size_t>(p)] & (1u << i))) d.natural[static_cast<std::size_t>(3 * p + i)] = n++;
   d.first_shadow = n;
-  // node_at_point (decoupled shadows): the node alone at each lattice point, −1 where a split left two.
-  std::vector<std::uint8_t> alone(static_cast<std::size_t>(net.node_count), room == NetworkSystem::SplitRoom::coupled_shadows ? 1 : 0);
+  // A node has a shadow when it is alone at its lattice point (node_at_point: −1 where a split
+  // left two; every node of the untorn network that coupled shadows need).
+  std::vector<std::uint8_t> alone(static_cast<std::size_t>(net.node_count), 0);
   for (const int p : node_at_point)
     if (p >= 0) alone[static_cast<std::size_t>(p)] = 1;
   if (room != NetworkSystem::SplitRoom::none)
@@ -826,6 +827,14 @@ void supernodal_solve_double(const cholmod_factor& L, const double* lx, const do
 }
 } // namespace
 
+template <class Value>
+void NetworkSystem::scale_decoupled_shadows(Value* v, int power) const noexcept {
+  for (int d = m_factor_dofs; d < dof_count(); ++d) {
+    const double r = m_shadow_inverse_root[static_cast<std::size_t>(d - m_factor_dofs)];
+    v[d] = static_cast<Value>(static_cast<double>(v[d]) * (power == 2 ? r * r : r));
+  }
+}
+
 void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept {
   const int n = dof_count();
   if (n == 0) return;
@@ -834,10 +843,7 @@ void NetworkSystem::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noex
     std::copy(rhs.data(), rhs.data() + n, out.data());
     supernodal_solve_double(*m_factor, static_cast<const double*>(m_factor->x), m_inverse_diagonal.data(), out.data(), m_below.data(),
                             m_dots.data());
-    for (int d = m_factor_dofs; d < n; ++d) {
-      const double r = m_shadow_inverse_root[static_cast<std::size_t>(d - m_factor_dofs)];
-      out[d] *= r * r;
-    }
+    scale_decoupled_shadows(out.data(), 2);
     return;
   }
   for (int k = 0; k < n; ++k) m_solution_single[static_cast<std::size_t>(k)] = static_cast<float>(rhs[k]);
@@ -870,13 +876,6 @@ bool NetworkSystem::solve_in_place() noexcept {
                       m_rows_single.data(), m_rows_single.data() + m_rows_split);
   scale_decoupled_shadows(m_solution_single.data(), 2);
   return true;
-}
-
-void NetworkSystem::scale_decoupled_shadows(float* v, int power) const noexcept {
-  for (int d = m_factor_dofs; d < dof_count(); ++d) {
-    const double r = m_shadow_inverse_root[static_cast<std::size_t>(d - m_factor_dofs)];
-    v[d] = static_cast<float>(static_cast<double>(v[d]) * (power == 2 ? r * r : r));
-  }
 }
 
 } // namespace kerf

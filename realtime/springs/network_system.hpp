@@ -162,7 +162,8 @@ private:
   void size_solve_workspaces();
   /// v_d ← v_d (A_dd)^(−power/2) on the decoupled shadows' dofs (the diagonal block's L = √A_dd:
   /// power 1 for one triangular solve, 2 for both).
-  void scale_decoupled_shadows(float* v, int power) const noexcept;
+  template <class Value>
+  void scale_decoupled_shadows(Value* v, int power) const noexcept;
 
   std::vector<int> m_dof_of;
   Matrix m_matrix;

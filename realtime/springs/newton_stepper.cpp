@@ -190,7 +190,6 @@ void NewtonStepper::collect_refresh(const SpringNetwork& net, const Eigen::Matri
     // decoupled shadows') must be zero.
     bind_free_entries(net);
     m_r.setZero();
-    m_dx.setZero();
   }
   if (result.tag < m_splits)
     for (long index = result.tag + 1; index <= m_splits; ++index)

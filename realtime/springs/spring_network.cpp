@@ -103,27 +103,23 @@ SpringNetwork build_spring_network(const NetworkBlock& block, const std::vector<
 
 void merge_springs(SpringNetwork& net) noexcept {
   SpringArrays& s = net.springs;
-  // Key (a, b, kind) with a < b: a in bits 34-63, b in bits 4-33, kind in bits 0-3; the cell
-  // index in the low bits of a second array is not needed, the constant travels with the key.
+  // The constant travels with the key (its kind's): no cell index is needed beside it.
   const std::size_t n = 28 * static_cast<std::size_t>(net.cell_count());
   std::size_t m = 0;
   for (const auto& nodes : net.cell_nodes)
-    for (const CellSpring& cs : cell_springs) {
-      const auto p = static_cast<std::uint64_t>(nodes[static_cast<std::size_t>(cs.a)]);
-      const auto q = static_cast<std::uint64_t>(nodes[static_cast<std::size_t>(cs.b)]);
-      s.key[m++] = (std::min(p, q) << 34) | (std::max(p, q) << 4) | static_cast<std::uint64_t>(cs.type);
-    }
+    for (const CellSpring& cs : cell_springs)
+      s.key[m++] = spring_key(nodes[static_cast<std::size_t>(cs.a)], nodes[static_cast<std::size_t>(cs.b)], cs.type);
   std::sort(s.key.begin(), s.key.begin() + static_cast<std::ptrdiff_t>(n));
   int count = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint64_t key = s.key[i];
-    const int type = static_cast<int>(key & 15u);
+    const auto [a, b, type] = spring_of_key(key);
     if (i > 0 && key == s.key[i - 1]) {
       s.k[static_cast<std::size_t>(count - 1)] += net.spring_constant(type);
       continue;
     }
-    s.a[static_cast<std::size_t>(count)] = static_cast<int>(key >> 34);
-    s.b[static_cast<std::size_t>(count)] = static_cast<int>((key >> 4) & ((std::uint64_t{1} << 30) - 1));
+    s.a[static_cast<std::size_t>(count)] = a;
+    s.b[static_cast<std::size_t>(count)] = b;
     s.k[static_cast<std::size_t>(count)] = net.spring_constant(type);
     s.rest[static_cast<std::size_t>(count)] = net.rest_length(type);
     ++count;

@@ -98,7 +98,19 @@ struct SpringNetwork {
 SpringNetwork build_spring_network(const NetworkBlock& block, const std::vector<bool>& keep,
                                    const CellStiffness& stiffness, double density, double damping_time);
 
-/// Rebuilds `net.springs` from the cells' corners: every cell spring (a, b, kind) keyed, sorted
+/// A cell spring's key, by which the springs of cells that share them are found (merge_springs,
+/// VertexTearing): end nodes a < b and kind packed as a in bits 34-63, b in bits 4-33, kind in
+/// bits 0-3, so that sorting the keys sorts by (a, b, kind).
+[[nodiscard]] inline std::uint64_t spring_key(int p, int q, int kind) noexcept {
+  const auto a = static_cast<std::uint64_t>(p), b = static_cast<std::uint64_t>(q);
+  return ((a < b ? a : b) << 34) | ((a < b ? b : a) << 4) | static_cast<std::uint64_t>(kind);
+}
+/// The spring of a key: {a, b, kind}.
+[[nodiscard]] inline std::array<int, 3> spring_of_key(std::uint64_t key) noexcept {
+  return {static_cast<int>(key >> 34), static_cast<int>((key >> 4) & ((std::uint64_t{1} << 30) - 1)), static_cast<int>(key & 15u)};
+}
+
+/// Rebuilds `net.springs` from the cells' corners: every cell spring keyed (spring_key), sorted
 /// in place, equal keys merged with summed constants. Allocation-free once the arrays are sized
 /// (build_spring_network sizes them).
 void merge_springs(SpringNetwork& net) noexcept;

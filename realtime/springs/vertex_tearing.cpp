@@ -56,23 +56,18 @@ VertexTearing::VertexTearing(const SpringNetwork& net, double tensile_limit) : m
 }
 
 void VertexTearing::share_springs(const SpringNetwork& net) noexcept {
-  // Key (a, b, kind) with a < b packed as merge_springs packs it, beside the cell spring's index.
+  // Each cell spring's key (spring_key, as merge_springs keys them) beside its index.
   std::size_t m = 0;
   for (const auto& nodes : net.cell_nodes)
     for (const CellSpring& cs : cell_springs) {
-      const auto p = static_cast<std::uint64_t>(nodes[static_cast<std::size_t>(cs.a)]);
-      const auto q = static_cast<std::uint64_t>(nodes[static_cast<std::size_t>(cs.b)]);
-      m_pairing[m] = {(std::min(p, q) << 34) | (std::max(p, q) << 4) | static_cast<std::uint64_t>(cs.type), static_cast<int>(m)};
+      m_pairing[m] = {spring_key(nodes[static_cast<std::size_t>(cs.a)], nodes[static_cast<std::size_t>(cs.b)], cs.type), static_cast<int>(m)};
       ++m;
     }
   std::sort(m_pairing.begin(), m_pairing.begin() + static_cast<std::ptrdiff_t>(m));
   m_shared_count = 0;
   for (std::size_t i = 0; i < m; ++i) {
     const std::uint64_t key = m_pairing[i].first;
-    if (i == 0 || key != m_pairing[i - 1].first)
-      m_shared[static_cast<std::size_t>(m_shared_count++)] = {static_cast<int>(key >> 34),
-                                                              static_cast<int>((key >> 4) & ((std::uint64_t{1} << 30) - 1)),
-                                                              static_cast<int>(key & 15u)};
+    if (i == 0 || key != m_pairing[i - 1].first) m_shared[static_cast<std::size_t>(m_shared_count++)] = spring_of_key(key);
     m_spring_of[static_cast<std::size_t>(m_pairing[i].second)] = m_shared_count - 1;
   }
   m_topology = net.topology;
@@ -88,7 +83,7 @@ void VertexTearing::share_springs_after_split(const SpringNetwork& net, int copy
       const CellSpring& cs = cell_springs[static_cast<std::size_t>(k)];
       const int p = nodes[static_cast<std::size_t>(cs.a)], q = nodes[static_cast<std::size_t>(cs.b)];
       if (p != copy && q != copy) continue;
-      const std::array<int, 3> spring{std::min(p, q), std::max(p, q), cs.type};
+      const std::array<int, 3> spring = spring_of_key(spring_key(p, q, cs.type));
       int id = first;
       while (id < m_shared_count && m_shared[static_cast<std::size_t>(id)] != spring) ++id;
       if (id == m_shared_count) {

@@ -113,7 +113,9 @@ TEST_P(SplitCorrectionIn, KeptFactorCorrectedForSplitsSolvesLikeAFreshFactor) {
     ASSERT_TRUE(afterwards.add(kept, torn, xt, made[0].original, made[0].copy, before[0], wm, wk, tangent, &made[1], 1));
     ASSERT_TRUE(afterwards.add(kept, torn, xt, made[1].original, made[1].copy, before[1], wm, wk, tangent));
     // With decoupled shadows the system cannot be assembled torn until it is analysed again.
-    if (GetParam() == NetworkSystem::SplitRoom::decoupled_shadows) EXPECT_FALSE(kept.factorize());
+    if (GetParam() == NetworkSystem::SplitRoom::decoupled_shadows) {
+      EXPECT_FALSE(kept.factorize());
+    }
     // The fresh factor of the torn network at the same state (its own tear-ready analysis).
     NetworkSystem fresh(NetworkSystem::SolvePrecision::single_precision);
     fresh.rebuild(net, true);
