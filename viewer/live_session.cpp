@@ -2,8 +2,11 @@
 
 #include "viewer/viewed_model.hpp"
 
+#include "realtime/haptics/realtime_scheduling.hpp"
+
 #include <chrono>
 #include <cstdlib>
+#include <ctime>
 #include <stdexcept>
 #include <thread>
 
@@ -30,6 +33,18 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
   // alone the frames still come at about 60 Hz. Read when the first GL context is made, so set
   // here; a value the user set is kept.
   ::setenv("LP_NUM_THREADS", "0", 0);
+  // The servo thread gets a CPU of its own and the view stays off it: this thread renders, and the
+  // threads it starts (the GL driver's, the multi-rate model thread, which the loop starts from
+  // here) inherit its mask. A guest kernel that does not preempt system calls (PREEMPT_NONE)
+  // otherwise wakes the servo late whenever the render thread is in the kernel on the CPU the
+  // servo wakes on. The servo's CPU is settings.servo.cpu when set, else the last of the
+  // process's CPUs; with one CPU nothing moves.
+  ServoSettings servo_settings = settings.servo;
+  if (servo_settings.realtime && servo_settings.cpu < 0) servo_settings.cpu = last_of_several_cpus();
+  struct RestoreCpus {
+    CpuMask mask;
+    ~RestoreCpus() { restore_cpus(mask); }
+  } render_cpus{keep_off_cpu(servo_settings.cpu)};
   std::unique_ptr<ModelAdapter> adapter = make_model_adapter(shown, mesh);
   ViewedModel viewed(model, *adapter, 1.0 / settings.display_rate);
   ViewWindowSettings window_settings = settings.window;
@@ -44,7 +59,7 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
   view.show(viewed.frame());
   window.render();
 
-  ServoLoop loop(viewed, devices, settings.servo, nullptr);
+  ServoLoop loop(viewed, devices, servo_settings, nullptr);
   // The servo statistics are read in the thread that steps the model: only when that is the
   // servo thread itself (single-rate) are they the servo's own, race-free.
   if (settings.servo.model_rate <= 0.0) viewed.set_servo_timing(&loop.timing());
@@ -57,11 +72,19 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
 
   using Clock = std::chrono::steady_clock;
   double render_total = 0.0;
+  double render_cpu_total = 0.0;
+  auto thread_cpu_seconds = [] {
+    timespec t{};
+    ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  };
   auto draw = [&] {
     if (!viewed.update()) return;
     const auto begin = Clock::now();
+    const double cpu_begin = thread_cpu_seconds();
     view.show(viewed.frame());
     window.render();
+    render_cpu_total += thread_cpu_seconds() - cpu_begin;
     const double seconds = std::chrono::duration<double>(Clock::now() - begin).count();
     render_total += seconds;
     out.max_render_seconds = std::max(out.max_render_seconds, seconds);
@@ -105,6 +128,7 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
   out.max_capture_seconds = viewed.max_capture_seconds();
   out.blocked_snapshots = viewed.blocked_snapshots();
   out.mean_render_seconds = out.frames_rendered ? render_total / static_cast<double>(out.frames_rendered) : 0.0;
+  out.mean_render_cpu_seconds = out.frames_rendered ? render_cpu_total / static_cast<double>(out.frames_rendered) : 0.0;
   return out;
 }
 

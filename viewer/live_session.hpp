@@ -30,7 +30,8 @@ struct LiveViewReport {
   std::uint64_t frames_rendered = 0;   ///< frames the view drew
   double max_capture_seconds = 0.0;    ///< longest snapshot (time the view adds to one model step) [s]
   std::uint64_t blocked_snapshots = 0; ///< snapshots in which the stepping thread waited (ViewedModel::blocked_snapshots)
-  double mean_render_seconds = 0.0;    ///< render thread, per frame drawn [s]
+  double mean_render_seconds = 0.0;    ///< render thread, per frame drawn, wall clock [s]
+  double mean_render_cpu_seconds = 0.0; ///< render thread, per frame drawn, its own CPU time [s]
   double max_render_seconds = 0.0;
 };
 

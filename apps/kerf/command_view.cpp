@@ -231,11 +231,11 @@ void scene_live(const ViewOptions& o, const Scene& scene, const TetMesh& mesh, B
   if (o.no_view) std::printf("view: off (--no-view)\n");
   else
     std::printf("view: %llu snapshots (longest %.2f us in the %s thread, %llu waited), %llu frames drawn (mean %.2f ms, "
-                "max %.2f ms)\n",
+                "max %.2f ms, render thread CPU %.2f ms a frame)\n",
                 static_cast<unsigned long long>(report.frames_published), report.max_capture_seconds * 1e6,
                 o.model_rate > 0.0 ? "model" : "servo", static_cast<unsigned long long>(report.blocked_snapshots),
                 static_cast<unsigned long long>(report.frames_rendered), report.mean_render_seconds * 1e3,
-                report.max_render_seconds * 1e3);
+                report.max_render_seconds * 1e3, report.mean_render_cpu_seconds * 1e3);
   if (!o.screenshot.empty()) std::printf("wrote %s\n", o.screenshot.c_str());
 }
 

@@ -75,6 +75,8 @@ ServoLoop::ServoLoop(ToolModel& model, std::span<HapticDevice* const> devices, c
                                 std::to_string(settings.model_rate) + ")");
   if (!(settings.duration >= 0.0) || !std::isfinite(settings.duration))
     throw std::invalid_argument("servo loop: duration must be >= 0 s");
+  if (settings.cpu < -1)
+    throw std::invalid_argument("servo loop: cpu must be -1 (not pinned) or a CPU number (got " + std::to_string(settings.cpu) + ")");
   if (m_devices.empty() || m_count > static_cast<std::size_t>(max_session_tools))
     throw std::invalid_argument("servo loop: 1 to " + std::to_string(max_session_tools) + " devices, got " +
                                 std::to_string(m_count));
@@ -295,7 +297,7 @@ bool ServoLoop::tick(double now, double late) noexcept {
 }
 
 void ServoLoop::servo_thread() {
-  if (m_settings.realtime) m_realtime = enter_realtime(m_settings.priority);
+  if (m_settings.realtime) m_realtime = enter_realtime(m_settings.priority, m_settings.cpu);
   if (m_settings.on_realtime) m_settings.on_realtime(m_realtime);
   run_periodic(m_settings.rate, m_timing, nullptr, [this](double now, double late) { return tick(now, late); });
   m_model_thread_done.store(true, std::memory_order_relaxed);

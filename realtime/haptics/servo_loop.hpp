@@ -46,6 +46,9 @@ struct ServoSettings {
   VirtualCoupling coupling;   ///< off unless coupling.stiffness > 0
   bool realtime = true;       ///< try SCHED_FIFO and mlockall (falls back with a warning)
   int priority = 80;          ///< SCHED_FIFO priority of the servo thread (the model thread gets one less)
+  /// The CPU the servo thread is pinned to (with `realtime`); -1: wherever the scheduler puts it.
+  /// run_live_view pins it when the view renders beside it (viewer/live_session.hpp).
+  int cpu = -1;
   /// Called once from the servo thread, before its first tick, with what real-time setup it got
   /// (so a command line can warn at the start of a session). May be empty.
   std::function<void(const RealtimeSetup&)> on_realtime;
