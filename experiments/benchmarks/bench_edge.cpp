@@ -50,6 +50,20 @@ TetMesh cube(int n) {
   return m;
 }
 
+/// Times `original.cut(surface)` on a fresh copy of the body each iteration (the copy untimed);
+/// returns the last cut's report.
+GeometricCutReport time_cuts(benchmark::State& state, const CuttableBody& original, const SweptSurface& surface) {
+  GeometricCutReport report;
+  for (auto _ : state) {
+    state.PauseTiming();
+    CuttableBody body = original;
+    state.ResumeTiming();
+    report = body.cut(surface);
+    benchmark::DoNotOptimize(report);
+  }
+  return report;
+}
+
 // Argument: cells per side (10 -> 6000 tetrahedra, paper 000's size; 20 -> 48000).
 void geometric_cut(benchmark::State& state) {
   const CuttableBody original(cube(static_cast<int>(state.range(0))));
@@ -60,14 +74,7 @@ void geometric_cut(benchmark::State& state) {
   std::vector<Eigen::Vector3d> centres;
   for (int k = 0; k < 10; ++k) centres.push_back(origin + (-2.0 + 4.0 * k / 9.0) * b);
   const SweptSurface surface = sweep_edge(centres, a, 4.0); // 18 triangles
-  GeometricCutReport report;
-  for (auto _ : state) {
-    state.PauseTiming();
-    CuttableBody body = original;
-    state.ResumeTiming();
-    report = body.cut(surface);
-    benchmark::DoNotOptimize(report);
-  }
+  const GeometricCutReport report = time_cuts(state, original, surface);
   state.counters["tets"] = static_cast<double>(original.mesh().tets.rows());
   state.counters["cut_tets"] = report.cut_tets;
   state.counters["fragments"] = report.fragments;
@@ -80,14 +87,7 @@ void geometric_cut_partial(benchmark::State& state) {
   std::vector<Eigen::Vector3d> centres;
   for (int k = 0; k < 10; ++k) centres.push_back(Eigen::Vector3d(0.55, 0.5, 0.4 + 1.6 * k / 9.0));
   const SweptSurface surface = sweep_edge(centres, Eigen::Vector3d::UnitY(), 4.0);
-  GeometricCutReport report;
-  for (auto _ : state) {
-    state.PauseTiming();
-    CuttableBody body = original;
-    state.ResumeTiming();
-    report = body.cut(surface);
-    benchmark::DoNotOptimize(report);
-  }
+  const GeometricCutReport report = time_cuts(state, original, surface);
   state.counters["cut_tets"] = report.cut_tets;
   state.counters["fragments"] = report.fragments;
 }

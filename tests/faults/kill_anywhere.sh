@@ -22,11 +22,7 @@ kerf="$1"
 what="$2"
 work="$3"
 kills_wanted="$4"
-py=/usr/bin/python3
-rm -rf "$work"
-mkdir -p "$work"
-cd "$work"
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/fault_script_start.sh" "$work"
 
 cat > tiny.toml <<'TOML'
 [study]

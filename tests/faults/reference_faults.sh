@@ -20,12 +20,7 @@ set -euo pipefail
 kerf="$1"
 scenes="$2"
 work="$3"
-py=/usr/bin/python3
-rm -rf "$work"
-mkdir -p "$work"
-cd "$work"
-
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/fault_script_start.sh" "$work"
 sed -e 's/^element_size = "2.5 mm"/element_size = "5 mm"/' -e 's/^element_degree = 2 /element_degree = 1 /' "$scenes/clay_pull.toml" > coarse.toml
 grep -q '^element_size = "5 mm"' coarse.toml || fail "clay_pull.toml has no element_size line to coarsen"
 grep -q '^element_degree = 1 ' coarse.toml || fail "clay_pull.toml has no element_degree line to set to linear"

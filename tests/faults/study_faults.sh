@@ -14,11 +14,7 @@ set -euo pipefail
 kerf="$1"
 scenes="$2"
 work="$3"
-py=/usr/bin/python3
-rm -rf "$work"
-mkdir -p "$work"
-cd "$work"
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$(dirname "${BASH_SOURCE[0]}")/fault_script_start.sh" "$work"
 
 cat > faults.toml <<'TOML'
 [study]

@@ -5,6 +5,8 @@
 #include "meshes/mesh_error.hpp"
 #include "meshes/tet_quality.hpp"
 
+#include "tests/meshes/one_tetrahedron.hpp"
+
 #include <gtest/gtest.h>
 
 #include <array>
@@ -132,12 +134,7 @@ TEST(GmshIo, ReadErrorsNameTheFile) {
 }
 
 TEST(GmshIo, WritingToAnUnwritablePlaceThrowsAndLeavesNoTemporaryFile) {
-  TetMesh mesh;
-  mesh.nodes.resize(4, 3);
-  mesh.nodes << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  mesh.tets.resize(1, 4);
-  mesh.tets << 0, 1, 2, 3;
-  mesh.volume_groups.push_back({"body", 1, {0}});
+  const TetMesh mesh = test::one_tetrahedron();
   const fs::path dir = scratch_dir("unwritable");
   // The "directory" is a regular file: nothing can be created under it.
   const fs::path not_a_dir = dir / "file";

@@ -8,6 +8,8 @@
 #include "reference/load_path.hpp"
 #include "tests/reference/reference_test_meshes.hpp"
 
+#include "tests/reference/proportional_load.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -50,11 +52,7 @@ TEST(CohesiveInterface, BarPulledApartDissipatesToughnessTimesArea) {
   double work = 0.0, previous_force = 0.0, peak = 0.0;
   const double area = W * W;
   for (int k = 1; k <= steps; ++k) {
-    LoadTarget target;
-    target.load.load_factor = static_cast<double>(k) / steps;
-    target.load.time = target.load.load_factor;
-    target.sample = static_cast<std::size_t>(k);
-    const LoadStepReport step = path.advance(target);
+    const LoadStepReport step = path.advance(test::proportional_target(k, steps));
     ASSERT_TRUE(step.converged);
     // The pull's force on the body: minus the reaction (body on the pulled face).
     const double force = -step.equilibrium.boundary_reactions[1].force.x();

@@ -27,6 +27,8 @@
 #include "reference/load_path.hpp"
 #include "tests/reference/reference_test_meshes.hpp"
 
+#include "tests/reference/proportional_load.hpp"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -173,10 +175,7 @@ DcbResult run_dcb(const DoubleCantileverBeam& d, const DcbMesh& m, double max_op
   r.cells = solver.cell_count();
   double previous_upper = 0.0, previous_lower = 0.0;
   for (int k = 1; k <= steps; ++k) {
-    LoadTarget target;
-    target.load.load_factor = static_cast<double>(k) / steps;
-    target.load.time = target.load.load_factor;
-    target.sample = static_cast<std::size_t>(k);
+    const LoadTarget target = test::proportional_target(k, steps);
     const LoadStepReport step = path.advance(target);
     r.newton += step.newton_iterations;
     r.cutbacks += step.cutbacks;

@@ -14,6 +14,8 @@
 #include "tests/realtime/springs/model_fixtures.hpp"
 #include "viewer/viewed_model.hpp"
 
+#include "tests/meshes/one_tetrahedron.hpp"
+
 #include <gtest/gtest.h>
 #include <vtkDataSet.h>
 
@@ -291,12 +293,7 @@ TEST(ModelAdapter, EachCatalogueModelIsReadByItsOwnAdapter) {
 TEST(PvdSeries, ReadsStepsAtTheirDeformedPositions) {
   const auto dir = std::filesystem::temp_directory_path() / ("kerf_test_pvd_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir / "fields");
-  TetMesh mesh;
-  mesh.nodes.resize(4, 3);
-  mesh.nodes << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  mesh.tets.resize(1, 4);
-  mesh.tets << 0, 1, 2, 3;
-  mesh.volume_groups.push_back({"body", 1, {0}});
+  const TetMesh mesh = test::one_tetrahedron();
   for (int k = 0; k < 2; ++k) {
     Eigen::MatrixXd u = Eigen::MatrixXd::Zero(4, 3);
     u.col(2).setConstant(0.5 * k);

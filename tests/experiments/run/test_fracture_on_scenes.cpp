@@ -6,6 +6,7 @@
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
 #include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/resolve_scene.hpp"
 #include "formats/scene/scene_reader.hpp"
 
 #include <gtest/gtest.h>
@@ -14,10 +15,6 @@ using namespace kerf;
 
 namespace {
 
-std::filesystem::path scene_file(const std::string& name) {
-  return std::filesystem::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / (name + ".toml");
-}
-
 struct SceneRun {
   Scene scene;
   TetMesh mesh;
@@ -25,7 +22,7 @@ struct SceneRun {
 };
 
 SceneRun run(const std::string& name, const std::function<void(Scene&)>& edit = {}) {
-  SceneRun r{read_scene(scene_file(name)), {}, {}};
+  SceneRun r{read_scene(resolve_scene(name)), {}, {}};
   if (edit) edit(r.scene);
   r.mesh = scene_mesh(r.scene);
   BuiltModel built = make_model("fracture", r.scene, r.mesh);
@@ -155,8 +152,8 @@ TEST(FractureOnScenes, TwoLayerCutUsesEachLayersToughness) {
 TEST(FractureOnScenes, RefusesScenesItCannotRepresent) {
   // clay_tear declares tearing and has two sphere tools; clay_pull has a sphere, no blade.
   for (const char* name : {"clay_tear", "clay_pull"}) {
-    const Scene s = read_scene(scene_file(name));
+    const Scene s = read_scene(resolve_scene(name));
     EXPECT_THROW(require_model_for_scene("fracture", s), ModelMismatch) << name;
   }
-  EXPECT_THROW(require_model_for_scene("no_such_model", read_scene(scene_file("potato_rect_cut"))), std::invalid_argument);
+  EXPECT_THROW(require_model_for_scene("no_such_model", read_scene(resolve_scene("potato_rect_cut"))), std::invalid_argument);
 }

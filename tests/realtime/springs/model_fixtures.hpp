@@ -5,7 +5,14 @@
 #include "meshes/box_tet_mesh.hpp"
 #include "realtime/springs/spring_network_model.hpp"
 
+#include <array>
+
 namespace kerf::test {
+
+/// Every integrator of the spring network (SpringIntegrator), for tests that run each.
+inline constexpr std::array<SpringIntegrator, 4> every_spring_integrator{
+    SpringIntegrator::quasi_static, SpringIntegrator::implicit_euler, SpringIntegrator::symplectic_euler,
+    SpringIntegrator::linearly_implicit_euler};
 
 /// 40 x 40 x 20 mm clay block (E = 0.5 MPa, ν = 0.45, ρ = 1700 kg/m^3, η = 10 Pa s, the scene's
 /// estimates), base bonded, a 2 mm stylus touching the centre of the top face.

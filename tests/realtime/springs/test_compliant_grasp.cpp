@@ -338,9 +338,7 @@ TEST(CompliantGrasp, EveryIntegratorSettlesOnTheStaticForce) {
   // same nodes (checked in AStiffLayerRecoversTheRigidGrasp).
   const TetMesh mesh = test::clay_pull_mesh();
   std::vector<double> final_force;
-  for (const SpringIntegrator integrator :
-       {SpringIntegrator::quasi_static, SpringIntegrator::implicit_euler, SpringIntegrator::symplectic_euler,
-        SpringIntegrator::linearly_implicit_euler}) {
+  for (const SpringIntegrator integrator : test::every_spring_integrator) {
     SpringNetworkSetup s = test::clay_pull_setup(integrator);
     s.styluses[0].grasp_stiffness = clay_k;
     s.styluses[0].grasp_disc_radius = 4e-3;

@@ -129,57 +129,57 @@ TEST(LatticeForces, GershgorinBoundEqualsTheFlatArrays) {
   }
 }
 
+/// A moving, damped trajectory of 200 sub-steps of half the stability limit from a displaced
+/// state (node 0 of the fixed layer raised 10 µm a step): symplectic_euler_step over
+/// network_forces (x, v) and the lattice's own sub-steps in `precision` (y, w).
+struct TwoTrajectories {
+  Scattered s;
+  Eigen::Matrix3Xd x, v, y, w;
+};
+TwoTrajectories step_both_ways(LatticeForces::ForcePrecision precision) {
+  TwoTrajectories t{constrained_block(3), {}, {}, {}, {}};
+  Scattered& s = t.s;
+  const double h = 0.5 * symplectic_euler_stability_limit(highest_angular_frequency(s.net), s.net.damping_time);
+  LatticeForces lattice(s.net);
+  t.x = s.x, t.v = s.v;
+  Eigen::Matrix3Xd f(3, s.net.node_capacity());
+  const int fixed = 0; // a node of the fixed layer, moved by the caller every step
+  EXPECT_EQ(s.net.constraint[fixed], fix_all);
+  lattice.gather(s.x, s.v);
+  for (int k = 1; k <= 200; ++k) {
+    const Eigen::Vector3d target = s.net.rest.col(fixed) + Eigen::Vector3d(0, 0, 1e-5 * k), rate(0, 0, 1e-5 / h);
+    t.x.col(fixed) = target, t.v.col(fixed) = rate;
+    symplectic_euler_step(s.net, t.x, t.v, h, f);
+    lattice.place(fixed, target, rate);
+    lattice.substep(s.net, h, precision);
+  }
+  t.y.resize(3, s.net.node_capacity()), t.w.resize(3, s.net.node_capacity());
+  lattice.scatter(t.y, t.w);
+  return t;
+}
+
 TEST(LatticeForces, SubstepsEqualSymplecticEulerSteps) {
   // Sub-steps kept on the lattice (gather, place a prescribed node, substep, scatter) against
   // symplectic_euler_step over network_forces, from a displaced, moving, damped state: the same
   // trajectory to round-off.
-  Scattered s = constrained_block(3);
-  const double h = 0.5 * symplectic_euler_stability_limit(highest_angular_frequency(s.net), s.net.damping_time);
-  LatticeForces lattice(s.net);
-  Eigen::Matrix3Xd x = s.x, v = s.v, f(3, s.net.node_capacity());
-  const int fixed = 0; // a node of the fixed layer, moved by the caller every step
-  ASSERT_EQ(s.net.constraint[fixed], fix_all);
-  lattice.gather(s.x, s.v);
-  for (int k = 1; k <= 200; ++k) {
-    const Eigen::Vector3d target = s.net.rest.col(fixed) + Eigen::Vector3d(0, 0, 1e-5 * k), rate(0, 0, 1e-5 / h);
-    x.col(fixed) = target, v.col(fixed) = rate;
-    symplectic_euler_step(s.net, x, v, h, f);
-    lattice.place(fixed, target, rate);
-    lattice.substep(s.net, h);
-  }
-  Eigen::Matrix3Xd y(3, s.net.node_capacity()), w(3, s.net.node_capacity());
-  lattice.scatter(y, w);
-  const int n = s.net.node_count;
-  EXPECT_LT((y - x).leftCols(n).cwiseAbs().maxCoeff(), 1e-12 * (x - s.net.rest).leftCols(n).cwiseAbs().maxCoeff());
-  EXPECT_LT((w - v).leftCols(n).cwiseAbs().maxCoeff(), 1e-10 * v.leftCols(n).cwiseAbs().maxCoeff());
-  EXPECT_GT((x - s.x).leftCols(n).cwiseAbs().maxCoeff(), 1e-6); // it did move
+  const TwoTrajectories t = step_both_ways(LatticeForces::ForcePrecision::double_precision);
+  const int n = t.s.net.node_count;
+  EXPECT_LT((t.y - t.x).leftCols(n).cwiseAbs().maxCoeff(), 1e-12 * (t.x - t.s.net.rest).leftCols(n).cwiseAbs().maxCoeff());
+  EXPECT_LT((t.w - t.v).leftCols(n).cwiseAbs().maxCoeff(), 1e-10 * t.v.leftCols(n).cwiseAbs().maxCoeff());
+  EXPECT_GT((t.x - t.s.x).leftCols(n).cwiseAbs().maxCoeff(), 1e-6); // it did move
 }
 
 TEST(LatticeForces, SinglePrecisionSubstepsFollowTheDoubleOnes) {
   // The same moving, damped trajectory as above with the force loops in single precision
   // (positions and velocities in double): it follows symplectic_euler_step's double-precision
   // trajectory to the single-precision round-off of the forces (~10⁻⁷ relative per sub-step).
-  Scattered s = constrained_block(3);
-  const double h = 0.5 * symplectic_euler_stability_limit(highest_angular_frequency(s.net), s.net.damping_time);
-  LatticeForces lattice(s.net);
-  Eigen::Matrix3Xd x = s.x, v = s.v, f(3, s.net.node_capacity());
-  const int fixed = 0;
-  lattice.gather(s.x, s.v);
-  for (int k = 1; k <= 200; ++k) {
-    const Eigen::Vector3d target = s.net.rest.col(fixed) + Eigen::Vector3d(0, 0, 1e-5 * k), rate(0, 0, 1e-5 / h);
-    x.col(fixed) = target, v.col(fixed) = rate;
-    symplectic_euler_step(s.net, x, v, h, f);
-    lattice.place(fixed, target, rate);
-    lattice.substep(s.net, h, LatticeForces::ForcePrecision::single_precision);
-  }
-  Eigen::Matrix3Xd y(3, s.net.node_capacity()), w(3, s.net.node_capacity());
-  lattice.scatter(y, w);
-  const int n = s.net.node_count;
-  const double moved = (x - s.net.rest).leftCols(n).cwiseAbs().maxCoeff();
-  const double deviation = (y - x).leftCols(n).cwiseAbs().maxCoeff();
+  const TwoTrajectories t = step_both_ways(LatticeForces::ForcePrecision::single_precision);
+  const int n = t.s.net.node_count;
+  const double moved = (t.x - t.s.net.rest).leftCols(n).cwiseAbs().maxCoeff();
+  const double deviation = (t.y - t.x).leftCols(n).cwiseAbs().maxCoeff();
   EXPECT_LT(deviation, 1e-5 * moved);
   EXPECT_GT(deviation, 0.0); // the single-precision path was taken
-  EXPECT_LT((w - v).leftCols(n).cwiseAbs().maxCoeff(), 1e-4 * v.leftCols(n).cwiseAbs().maxCoeff());
+  EXPECT_LT((t.w - t.v).leftCols(n).cwiseAbs().maxCoeff(), 1e-4 * t.v.leftCols(n).cwiseAbs().maxCoeff());
 }
 
 TEST(NetworkSystem, SolvesAgainstADenseFactorisation) {

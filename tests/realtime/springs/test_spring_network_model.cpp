@@ -38,9 +38,7 @@ TEST(SpringNetworkModel, BuildsAroundTheStylus) {
 TEST(SpringNetworkModel, PullForceFromEachIntegrator) {
   const TetMesh mesh = test::clay_pull_mesh();
   std::vector<double> final_force;
-  for (const SpringIntegrator integrator :
-       {SpringIntegrator::quasi_static, SpringIntegrator::implicit_euler, SpringIntegrator::symplectic_euler,
-        SpringIntegrator::linearly_implicit_euler}) {
+  for (const SpringIntegrator integrator : test::every_spring_integrator) {
     SpringNetworkModel model(mesh, test::clay_pull_setup(integrator));
     std::array<ToolState, 1> tool;
     std::array<ForceSample, 1> force;

@@ -6,6 +6,7 @@
 #include "experiments/models/model_catalogue.hpp"
 #include "experiments/models/run_model.hpp"
 #include "formats/scene/scene_mesh.hpp"
+#include "formats/scene/resolve_scene.hpp"
 #include "formats/scene/scene_reader.hpp"
 #include "realtime/voxel/voxel_surface_cutting_model.hpp"
 
@@ -18,10 +19,6 @@
 using namespace kerf;
 
 namespace {
-
-std::filesystem::path scene_file(const std::string& name) {
-  return std::filesystem::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / (name + ".toml");
-}
 
 struct SceneRun {
   Scene scene;
@@ -56,7 +53,7 @@ std::pair<double, double> cut_force_fifths(const ForceProfile& p) {
 } // namespace
 
 TEST(VoxelOnScenes, TableOneIsReadInThePapersMillimetreUnit) {
-  const Scene scene = read_scene(scene_file("sponge_cut_constant"));
+  const Scene scene = read_scene(resolve_scene("sponge_cut_constant"));
   const SceneRun r = run(scene);
   // docs/models.md (voxel): "20.0 N/m^2" -> E = 20 N/mm^2 = 2e7 Pa, k_e = E x 1 mm = 2e4 N/m;
   // "0.5 N s/m^2" -> λ = 0.5 N s/mm^2 = 5e5 N s/m^2, per unit penetration (F = λ δ dδ/dt).
@@ -70,8 +67,8 @@ TEST(VoxelOnScenes, TableOneIsReadInThePapersMillimetreUnit) {
 TEST(VoxelOnScenes, SpongeCutsGiveFlatAndGrowingCuttingForces) {
   // Paper 002 Fig. 5: constant depth (0.5 mm) -> flat; proportional depth (0 -> 0.5 mm) ->
   // growing, as the DCS 0.066 E d follows the depth d (0.66 N at 0.5 mm).
-  const SceneRun constant = run(read_scene(scene_file("sponge_cut_constant")));
-  const SceneRun proportional = run(read_scene(scene_file("sponge_cut_proportional")));
+  const SceneRun constant = run(read_scene(resolve_scene("sponge_cut_constant")));
+  const SceneRun proportional = run(read_scene(resolve_scene("sponge_cut_proportional")));
   for (const SceneRun* r : {&constant, &proportional}) {
     for (const ProfileRow& row : r->profile.rows) ASSERT_TRUE(row.force.allFinite());
     // The cut runs from x = 0.1 mm to 0.9 mm: Cl at the end ~0.8 mm.
@@ -87,7 +84,7 @@ TEST(VoxelOnScenes, SpongeCutsGiveFlatAndGrowingCuttingForces) {
 
 TEST(VoxelOnScenes, DcsAndClipFrictionSwitchFromTheSceneFile) {
   // The paper's case a) (neither), read from a copy of the scene with both keys false.
-  std::ifstream in(scene_file("sponge_cut_constant"));
+  std::ifstream in(resolve_scene("sponge_cut_constant"));
   std::stringstream text;
   text << in.rdbuf();
   std::string toml = text.str();
@@ -100,7 +97,7 @@ TEST(VoxelOnScenes, DcsAndClipFrictionSwitchFromTheSceneFile) {
   EXPECT_FALSE(scene.voxel->depth_cutting_stiffness);
   EXPECT_FALSE(scene.voxel->clip_friction);
   const SceneRun case_a = run(scene);
-  const SceneRun case_d = run(read_scene(scene_file("sponge_cut_constant")));
+  const SceneRun case_d = run(read_scene(resolve_scene("sponge_cut_constant")));
   const auto [a_first, a_last] = cut_force_fifths(case_a.profile);
   const auto [d_first, d_last] = cut_force_fifths(case_d.profile);
   // Case a) feels only the point cut (wall force up to 0.1 N, friction of the bottom); case d)
@@ -123,7 +120,7 @@ TEST(VoxelOnScenes, AKnifeIsRenderedByTheStickAtItsPoint) {
   // sponge_knife_cut_*: a 0.1 mm knife, edge e = (3, 0, 4)/5 of 1 mm, cutting direction
   // d = (4, 0, -3)/5. The stick (docs/models.md, voxel, "A knife"): radius Cw = t/2 = 0.05 mm,
   // centre = the edge's lower end (midpoint - 0.5 mm e) - Cw d.
-  const Scene scene = read_scene(scene_file("sponge_knife_cut_constant"));
+  const Scene scene = read_scene(resolve_scene("sponge_knife_cut_constant"));
   const TetMesh mesh = scene_mesh(scene);
   BuiltModel built = make_model("voxel", scene, mesh);
   EXPECT_DOUBLE_EQ(built.parameters["tool_radius_m"].get<double>(), 0.05e-3);
@@ -158,7 +155,7 @@ TEST(VoxelOnScenes, AKnifeIsRenderedByTheStickAtItsPoint) {
 
 TEST(VoxelOnScenes, RefusesScenesWithoutTableOneOrWithMoreThanOneTool) {
   for (const char* name : {"potato_rect_cut", "potato_wedge_cut", "liver_prism_cut"}) {
-    const Scene s = read_scene(scene_file(name));
+    const Scene s = read_scene(resolve_scene(name));
     try {
       require_model_for_scene("voxel", s);
       ADD_FAILURE() << name << " was accepted";
@@ -168,13 +165,13 @@ TEST(VoxelOnScenes, RefusesScenesWithoutTableOneOrWithMoreThanOneTool) {
   }
   // clay_cut_apart: a blade and a stylus.
   try {
-    require_model_for_scene("voxel", read_scene(scene_file("clay_cut_apart")));
+    require_model_for_scene("voxel", read_scene(resolve_scene("clay_cut_apart")));
     ADD_FAILURE() << "clay_cut_apart was accepted";
   } catch (const ModelMismatch& e) {
     EXPECT_NE(std::string(e.what()).find("one cutting stick"), std::string::npos) << e.what();
   }
   // clay_pull: one sphere, but no [models.voxel] (and no cutting).
-  EXPECT_THROW(require_model_for_scene("voxel", read_scene(scene_file("clay_pull"))), ModelMismatch);
+  EXPECT_THROW(require_model_for_scene("voxel", read_scene(resolve_scene("clay_pull"))), ModelMismatch);
 }
 
 TEST(VoxelOnScenes, KnifeCutForceStepsAreTheOnesThePapersEquationsAllow) {
@@ -192,7 +189,7 @@ TEST(VoxelOnScenes, KnifeCutForceStepsAreTheOnesThePapersEquationsAllow) {
   // A sample may hold both advances. The bound is their sum plus the smooth changes (the modes
   // stay "cutting" through the segment, so DCS and CFF are not switched). With Table 1: k_e =
   // 2e4 N/m, F_crit,d = 0.3 N, F_crit,c = 0.1 N, μ = 0.8, λ = 5e5 N s/m².
-  const SceneRun r = run(read_scene(scene_file("sponge_knife_cut_proportional")));
+  const SceneRun r = run(read_scene(resolve_scene("sponge_knife_cut_proportional")));
   const double ke = 2e4, lambda = 5e5, mu = 0.8, v = 1e-3, dt = 1e-3;
   const double smooth = ke * v * dt;
   const double delta_max = (0.3 + smooth) / ke;
