@@ -373,8 +373,69 @@ NewtonReport NewtonStepper::advance_linearised(const SpringNetwork& net, Eigen::
   return report;
 }
 
-// One function beyond ~80 lines: the iteration's steps share its state (the accepted iterate,
-// the Anderson history, whether the iterate's potential is double precision).
+// Anderson mixing (Walker & Ni, "Anderson acceleration for fixed-point iterations", SIAM J.
+// Numer. Anal. 49(4), 2011): with the differences ΔU, ΔG of the last iterates and steps,
+//   γ = argmin |g − ΔG γ|₂,   u ← u + g − (ΔU + ΔG) γ,
+// the kept-factor iteration's GMRES-like acceleration (its error contracts by the kept
+// factor's mismatch per step otherwise).
+bool NewtonStepper::anderson_mix(AndersonState& state) noexcept {
+  const int m = m_free_count;
+  const int depth = m_policy.anderson_depth;
+  m_u_next.head(m) = m_u.head(m) + m_g.head(m);
+  bool mixed = false;
+  if (depth > 0 && state.have_previous) {
+    m_du.col(state.slot).head(m) = m_u.head(m) - m_u_previous.head(m);
+    m_dg.col(state.slot).head(m) = m_g.head(m) - m_g_previous.head(m);
+    state.slot = (state.slot + 1) % depth;
+    state.history = std::min(state.history + 1, depth);
+    const int history = state.history;
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, max_anderson_depth, max_anderson_depth> gram(history, history);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_anderson_depth, 1> rhs(history);
+    for (int i = 0; i < history; ++i) {
+      rhs[i] = m_dg.col(i).head(m).dot(m_g.head(m));
+      for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = m_dg.col(i).head(m).dot(m_dg.col(j).head(m));
+    }
+    // Tikhonov regularisation of the normal equations at 10⁻¹⁰ of their scale.
+    gram.diagonal().array() += 1e-10 * gram.diagonal().maxCoeff() + 1e-300;
+    const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_anderson_depth, 1> gamma = gram.ldlt().solve(rhs);
+    if (gamma.allFinite()) {
+      for (int i = 0; i < history; ++i) m_u_next.head(m) -= gamma[i] * (m_du.col(i).head(m) + m_dg.col(i).head(m));
+      mixed = true;
+    }
+  }
+  m_u_previous.head(m) = m_u.head(m);
+  m_g_previous.head(m) = m_g.head(m);
+  state.have_previous = true;
+  return mixed;
+}
+
+bool NewtonStepper::keep_factor_for(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt,
+                                    NewtonReport& report) noexcept {
+  // A split the correction could not take (more splits than it holds before a refresh came):
+  // with coupled shadows the torn network is factorised here, the one factorisation a servo step
+  // may make; with decoupled ones (which cannot be assembled torn without a new analysis) the
+  // iteration goes on with the factor as corrected so far while a fresh one is computed.
+  const bool refactor_here = m_factor_dt < 0.0 || (m_uncorrected && active().split_room() != NetworkSystem::SplitRoom::decoupled_shadows);
+  if (refactor_here) {
+    // Never primed, or uncorrected splits on coupled shadows: factorise here.
+    if (m_refresh) {
+      m_refresh->wait();
+      if (m_refresh->busy()) m_refresh->collect(); // its system is about to be reused
+    }
+    if (!refactor(net, x, dt)) return false;
+    ++report.factorisations;
+  } else if (m_factor_dt != dt || m_correction.splits() > 0 || m_uncorrected) {
+    // A new dt, or splits the kept factor is only corrected for: a fresh factor (if none is
+    // being computed already).
+    request_refresh(net, x, dt);
+    collect_refresh(net, x, report);
+  }
+  return true;
+}
+
+// The iteration's steps share its state (the accepted iterate, the Anderson history, whether the
+// iterate's potential is double precision), so the kept-factor step, the acceptance and the
+// backtracking stay in one function.
 NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
                                              double dt) noexcept {
   NewtonReport report;
@@ -388,27 +449,9 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
     const int e = m_free_entry[static_cast<std::size_t>(k)];
     x.data()[e] += dt * v.data()[e];
   }
-  // A split the correction could not take (more splits than it holds before a refresh came):
-  // with coupled shadows the torn network is factorised here, the one factorisation a servo step
-  // may make; with decoupled ones (which cannot be assembled torn without a new analysis) the
-  // iteration goes on with the factor as corrected so far while a fresh one is computed.
-  const bool refactor_here = m_factor_dt < 0.0 || (m_uncorrected && active().split_room() != NetworkSystem::SplitRoom::decoupled_shadows);
-  if (refactor_here) {
-    // Never primed, or uncorrected splits on coupled shadows: factorise here.
-    if (m_refresh) {
-      m_refresh->wait();
-      if (m_refresh->busy()) m_refresh->collect(); // its system is about to be reused
-    }
-    if (!refactor(net, x, dt)) {
-      report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
-      return report;
-    }
-    ++report.factorisations;
-  } else if (m_factor_dt != dt || m_correction.splits() > 0 || m_uncorrected) {
-    // A new dt, or splits the kept factor is only corrected for: a fresh factor (if none is
-    // being computed already).
-    request_refresh(net, x, dt);
-    collect_refresh(net, x, report);
+  if (!keep_factor_for(net, x, dt, report)) {
+    report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
+    return report;
   }
   const double tolerance = m_tolerance_ratio * net.stiffness.edge * net.block.cell_size;
   // The predictor's residual only sets the first step (an approximate one already: the kept
@@ -422,9 +465,7 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
     potential_is_double = true;
   }
   for (int k = 0; k < m; ++k) m_u[k] = x.data()[m_free_entry[static_cast<std::size_t>(k)]];
-  const int depth = m_policy.anderson_depth;
-  int history = 0, slot = 0;
-  bool have_previous = false;
+  AndersonState anderson;
   while (report.iterations < m_max_iterations && norm > tolerance) {
     // The kept-factor step g = −Q⁻¹ r (Q: the kept factor corrected for the pending splits).
     m_correction.solve(active(), m_r, m_dx);
@@ -435,40 +476,12 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
       m_g[k] = g;
       slope += m_r[m_free_dof[static_cast<std::size_t>(k)]] * g;
     }
-    // Anderson mixing (Walker & Ni, "Anderson acceleration for fixed-point iterations", SIAM J.
-    // Numer. Anal. 49(4), 2011): with the differences ΔU, ΔG of the last iterates and steps,
-    //   γ = argmin |g − ΔG γ|₂,   u ← u + g − (ΔU + ΔG) γ,
-    // the kept-factor iteration's GMRES-like acceleration (its error contracts by the kept
-    // factor's mismatch per step otherwise).
-    m_u_next.head(m) = m_u.head(m) + m_g.head(m);
-    bool mixed = false;
-    if (depth > 0 && have_previous) {
-      m_du.col(slot).head(m) = m_u.head(m) - m_u_previous.head(m);
-      m_dg.col(slot).head(m) = m_g.head(m) - m_g_previous.head(m);
-      slot = (slot + 1) % depth;
-      history = std::min(history + 1, depth);
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, max_anderson_depth, max_anderson_depth> gram(history, history);
-      Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_anderson_depth, 1> rhs(history);
-      for (int i = 0; i < history; ++i) {
-        rhs[i] = m_dg.col(i).head(m).dot(m_g.head(m));
-        for (int j = 0; j <= i; ++j) gram(i, j) = gram(j, i) = m_dg.col(i).head(m).dot(m_dg.col(j).head(m));
-      }
-      // Tikhonov regularisation of the normal equations at 10⁻¹⁰ of their scale.
-      gram.diagonal().array() += 1e-10 * gram.diagonal().maxCoeff() + 1e-300;
-      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, max_anderson_depth, 1> gamma = gram.ldlt().solve(rhs);
-      if (gamma.allFinite()) {
-        for (int i = 0; i < history; ++i) m_u_next.head(m) -= gamma[i] * (m_du.col(i).head(m) + m_dg.col(i).head(m));
-        mixed = true;
-      }
-    }
+    const bool mixed = anderson_mix(anderson);
     double mixed_slope = slope;
     if (mixed) {
       mixed_slope = 0.0;
       for (int k = 0; k < m; ++k) mixed_slope += m_r[m_free_dof[static_cast<std::size_t>(k)]] * (m_u_next[k] - m_u[k]);
     }
-    m_u_previous.head(m) = m_u.head(m);
-    m_g_previous.head(m) = m_g.head(m);
-    have_previous = true;
     const double potential = m_potential;
     // Accepted: a lower residual, or (from a double-precision potential) Armijo's decrease of
     // the potential along a descent direction (through a snap-through the residual may have to
@@ -485,9 +498,7 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
       continue;
     }
     // Backtracking along the plain step g (the mixing's history restarts).
-    history = 0;
-    slot = 0;
-    have_previous = false;
+    anderson = AndersonState{};
     bool found = false;
     for (double alpha = mixed ? 1.0 : 0.5; alpha >= 1.0 / 32.0; alpha *= 0.5) {
       m_u_next.head(m) = m_u.head(m) + alpha * m_g.head(m);

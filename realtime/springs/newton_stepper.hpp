@@ -136,6 +136,20 @@ private:
   NewtonReport advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
   NewtonReport advance_linearised(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
   NewtonReport advance_implicit(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+  /// Implicit Euler's factor for a step of dt at x: the kept one (corrected for pending splits),
+  /// a fresh one asked for of the refresh worker when dt changed or splits are pending (adopted
+  /// when ready), or — never primed, or splits the correction could not take on coupled
+  /// shadows — factorised here (counted in `report`). False when that factorisation failed.
+  bool keep_factor_for(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt, NewtonReport& report) noexcept;
+  /// The mixing's history within one `advance`: differences held, the next column to write, and
+  /// whether a previous iterate exists (a backtracking step restarts it).
+  struct AndersonState {
+    int history = 0, slot = 0;
+    bool have_previous = false;
+  };
+  /// From the iterate m_u and its kept-factor step m_g: the next iterate m_u_next, Anderson-mixed
+  /// over the history when it has one (then true), else m_u + m_g; records u and g for the next.
+  bool anderson_mix(AndersonState& state) noexcept;
   NewtonReport advance_static(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
   /// The free entries (3 p + i with a dof) in node order, their dofs and node masses, from the
   /// system's numbering (after rebuild and after binding splits). Allocation-free.
