@@ -58,6 +58,142 @@ void add_cell_to_distributed(const dealii::FullMatrix<double>& cell_K, const dea
   if (error != 0) throw std::runtime_error("finite strain: PETSc could not add a cell's entries (error " + std::to_string(error) + ")");
 }
 
+
+using Impl = FiniteStrainSolver::Impl;
+using Dofs = std::vector<dealii::types::global_dof_index>;
+
+/// The Newmark step's inertia on cell `c` (β = 1/4): f_a += Σ_b M_ab a_b(u),
+/// a_b = 4/h² (u_b − u_n,b) − 4/h v_n,b − a_n,b, and ∂f_a/∂u_b = 4/h² M_ab, with
+/// M_ab = m_ij δ(c_a, c_b), m the cell's scalar mass matrix.
+void add_cell_inertia(const Impl& s, std::size_t c, const Dofs& local, const std::vector<unsigned>& comp,
+                      const dealii::Vector<double>& state, bool with_matrix, dealii::Vector<double>& cell_int,
+                      dealii::FullMatrix<double>& cell_K) {
+  const unsigned n = static_cast<unsigned>(local.size());
+  const Impl::Dynamics& d = *s.dynamics;
+  const std::vector<double>& m = d.cell_mass[c];
+  const double h2 = 4.0 / (d.step * d.step);
+  for (unsigned i = 0; i < n; ++i)
+    for (unsigned j = 0; j < n; ++j) {
+      if (comp[i] != comp[j]) continue;
+      const double Mij = m[d.node_of_dof[i] * d.nodes + d.node_of_dof[j]];
+      cell_int(i) += Mij * s.newmark_acceleration(local[j], state(local[j]));
+      if (with_matrix) cell_K(i, j) += h2 * Mij;
+    }
+}
+
+/// The stress of cell `c_index` at its quadrature points: f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
+/// into `cell_int` and, with the matrix, the tangent's blocks into `tangent`. `damping`: the
+/// Kelvin–Voigt law of a dynamic step's damped material (its velocities in `velocity`), or null.
+/// `gradN`: n entries of scratch.
+void add_cell_stress(const Impl& s, std::size_t c_index, const HyperelasticLaw& law, const KelvinVoigtDamping* damping,
+                     const std::vector<double>& cell_u, const std::vector<double>& velocity,
+                     const std::vector<unsigned>& comp, bool with_matrix, std::vector<Eigen::Vector3d>& gradN,
+                     CellTangentBlocks& tangent, dealii::Vector<double>& cell_int) {
+  const unsigned n = static_cast<unsigned>(cell_u.size());
+  for (unsigned q = 0; q < s.geometry.points; ++q) {
+    for (unsigned i = 0; i < n; ++i) gradN[i] = Eigen::Map<const Eigen::Vector3d>(s.geometry.gradient(c_index, q, s.geometry.node_of_dof[i]));
+    // F = I + Grad u = I + Σ_a u_a e_c ⊗ Grad N_a (total Lagrangian: gradients with respect to
+    // the reference configuration)
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    for (unsigned i = 0; i < n; ++i) F.row(comp[i]) += cell_u[i] * gradN[i].transpose();
+    const double JxW = s.geometry.JxW[c_index * s.geometry.points + q];
+    // The residual-only assemblies of the line search need P = F S alone (the same bits).
+    StressTangent st;
+    if (with_matrix) {
+      Eigen::Matrix3d S;
+      Tensor4 C4;
+      law.second_piola_and_tangent(F, S, C4);
+      st = first_piola_and_tangent(F, S, C4);
+    } else {
+      st.first_piola = F * law.second_piola(F);
+    }
+    if (damping) {
+      // Ḟ = Grad v = Σ_a v_a e_c ⊗ Grad N_a; P += P_v(F, Ḟ), 𝔸 += ∂P_v/∂F with ∂Ḟ/∂F = γ/(βh) = 2/h.
+      Eigen::Matrix3d F_rate = Eigen::Matrix3d::Zero();
+      for (unsigned i = 0; i < n; ++i) F_rate.row(comp[i]) += velocity[i] * gradN[i].transpose();
+      const StressTangent sv = kelvin_voigt_stress(*damping, F, F_rate, 2.0 / s.dynamics->step);
+      st.first_piola += sv.first_piola;
+      if (with_matrix) st.tangent += sv.tangent;
+    }
+    // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
+    for (unsigned i = 0; i < n; ++i) cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
+    if (!with_matrix) continue;
+    // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV, by blocks of component pairs
+    // (cell_tangent.hpp); 𝔸 of a hyperelastic law has the major symmetry 𝔸_iJkL = 𝔸_kLiJ, so K
+    // is symmetric and half its blocks are mirrored (the Kelvin–Voigt tangent has no such
+    // symmetry: then every block).
+    const double* G = s.geometry.gradient(c_index, q, 0);
+    if (s.geometry.nodes == 4) tangent.add<4>(G, st.tangent, JxW, !damping);
+    else tangent.add<10>(G, st.tangent, JxW, !damping);
+  }
+}
+
+/// The cell's boundary faces: the dead-load tractions (scaled by the load factor) and the tool's
+/// frictionless penalty contact, into `cell_ext` and, with the matrix, the contact's tangent
+/// into `cell_K`; the tallies (traction and contact force, contact points, area, largest
+/// pressure, penalty energy) into `out`. A cell that `cell_outside_tool` () finds wholly outside
+/// the tool is not searched.
+template <class CellIterator, class OutsideTool, class Tally>
+void add_boundary_faces(const Impl& s, const CellIterator& cell, const dealii::Vector<double>& state,
+                        const LoadState& load, bool with_matrix, OutsideTool& cell_outside_tool,
+                        const std::vector<unsigned>& comp, dealii::FEFaceValues<3>& ffv,
+                        std::vector<dealii::Tensor<1, 3>>& face_u, Tally& out, dealii::Vector<double>& cell_ext,
+                        dealii::FullMatrix<double>& cell_K) {
+  const unsigned n = static_cast<unsigned>(comp.size());
+  const dealii::FEValuesExtractors::Vector disp(0);
+  int near_tool = -1; // the cell's bound against the tool: -1 not tested yet, 0 outside, 1 may touch
+  for (const unsigned f : cell->face_indices()) {
+    if (!cell->face(f)->at_boundary()) continue;
+    const auto id = cell->face(f)->boundary_id();
+    Eigen::Vector3d traction_sum = Eigen::Vector3d::Zero();
+    const Eigen::Vector3d* traction = nullptr;
+    for (const auto& [group, t] : s.tractions)
+      if (s.in_group(id, group)) {
+        traction_sum += t;
+        traction = &traction_sum;
+      }
+    if (s.tool && near_tool < 0) near_tool = cell_outside_tool() ? 0 : 1;
+    const bool search = near_tool == 1;
+    if (traction == nullptr && !search) continue;
+    ffv.reinit(cell, f);
+    if (search) ffv[disp].get_function_values(state, face_u);
+    const Eigen::Vector3d side = search ? s.crack_side(cell, f) : Eigen::Vector3d::Zero();
+    for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
+      const double JxW = ffv.JxW(q);
+      Eigen::Vector3d t = Eigen::Vector3d::Zero();
+      if (traction != nullptr) {
+        t += load.load_factor * *traction;
+        out.traction_on_body += load.load_factor * *traction * JxW;
+      }
+      Eigen::Matrix3d dt_dx = Eigen::Matrix3d::Zero();
+      if (search) {
+        const Eigen::Vector3d x = to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
+        const ToolContactPoint c = tool_contact(*s.tool, load.tool_position, x, side);
+        if (c.inside) {
+          // t_c = ε_N p n (per unit reference area), p = −g
+          const Eigen::Vector3d tc = s.penalty * c.penetration * c.normal;
+          t += tc;
+          out.contact_on_body += tc * JxW;
+          ++out.contact_points;
+          out.contact_area += JxW;
+          out.max_pressure = std::max(out.max_pressure, s.penalty * c.penetration);
+          // Penalty energy ½ ε_N p² per reference area (its derivative is the traction above).
+          out.contact_energy += 0.5 * s.penalty * c.penetration * c.penetration * JxW;
+          // ∂t_c/∂x = ε_N (−n⊗n + p ∂n/∂x)
+          dt_dx = s.penalty * (-c.normal * c.normal.transpose() + c.penetration * c.normal_derivative);
+        }
+      }
+      for (unsigned i = 0; i < n; ++i) {
+        const double Ni = ffv.shape_value_component(i, q, comp[i]);
+        if (Ni == 0.0) continue;
+        cell_ext(i) += Ni * t[comp[i]] * JxW;
+        if (with_matrix && search)
+          for (unsigned j = 0; j < n; ++j)
+            cell_K(i, j) -= Ni * dt_dx(comp[i], comp[j]) * ffv.shape_value_component(j, q, comp[j]) * JxW;
+      }
+    }
+  }
+}
 } // namespace
 
 template <class Algebra>
@@ -152,7 +288,6 @@ void FiniteStrainSolver::Impl::assemble_cells(const dealii::Vector<double>& stat
   const CellGeometry& geo = geometry;
   dealii::FEFaceValues<3> ffv(*mapping, *fe, *face_quadrature,
                               dealii::update_values | dealii::update_quadrature_points | dealii::update_JxW_values);
-  const dealii::FEValuesExtractors::Vector disp(0);
   std::vector<dealii::Tensor<1, 3>> face_u(face_quadrature->size());
   std::vector<double> cell_u(n);
   dealii::FullMatrix<double> cell_K(n, n);
@@ -192,8 +327,8 @@ void FiniteStrainSolver::Impl::assemble_cells(const dealii::Vector<double>& stat
           if ((0.5 * (p[a] + p[b]) - p[k]).norm() < 1e-12) edge_ends.push_back({a, b});
     if (edge_ends.size() != 6) throw std::logic_error("finite strain: the quadratic tetrahedron's edge nodes are not edge midpoints");
   }
-  auto cell_outside_tool = [&](const std::vector<dealii::types::global_dof_index>& dofs) {
-    for (unsigned i = 0; i < n; ++i) control[node[i]][comp[i]] = reference_coordinate[dofs[i]] + cell_u[i];
+  auto cell_outside_tool = [&] {
+    for (unsigned i = 0; i < n; ++i) control[node[i]][comp[i]] = reference_coordinate[local[i]] + cell_u[i];
     for (std::size_t l = 0; l < edge_ends.size(); ++l)
       control[4 + l] = 2.0 * control[4 + l] - 0.5 * (control[edge_ends[l][0]] + control[edge_ends[l][1]]);
     return outside_together(*tool_bound, load.tool_position, control);
@@ -209,120 +344,21 @@ void FiniteStrainSolver::Impl::assemble_cells(const dealii::Vector<double>& stat
     cell_int = 0.0;
     cell_ext = 0.0;
     const HyperelasticLaw& law = *laws[cell->material_id()];
-    if (dynamics && dynamics->step > 0.0) {
-      // Inertia (Newmark β = 1/4): f_a += Σ_b M_ab a_b(u), a_b = 4/h² (u_b − u_n,b) − 4/h v_n,b − a_n,b,
-      // and ∂f_a/∂u_b = 4/h² M_ab. M_ab = m_ij δ(c_a, c_b), m the cell's scalar mass matrix.
-      const Dynamics& d = *dynamics;
-      const std::vector<double>& m = d.cell_mass[cell->active_cell_index()];
-      const double c = 4.0 / (d.step * d.step);
-      for (unsigned i = 0; i < n; ++i)
-        for (unsigned j = 0; j < n; ++j) {
-          if (comp[i] != comp[j]) continue;
-          const double Mij = m[d.node_of_dof[i] * d.nodes + d.node_of_dof[j]];
-          cell_int(i) += Mij * newmark_acceleration(local[j], state(local[j]));
-          if (with_matrix) cell_K(i, j) += c * Mij;
-        }
-    }
+    if (dynamics && dynamics->step > 0.0) add_cell_inertia(*this, c_index, local, comp, state, with_matrix, cell_int, cell_K);
     // Kelvin–Voigt damping (dynamic step): the Newmark velocity v_{n+1}(u) of the cell's DOFs.
     const bool damped = dynamics && dynamics->damped && dynamics->step > 0.0 &&
                         damping[cell->material_id()].retardation_time > 0.0;
     if (damped)
       for (unsigned i = 0; i < n; ++i) velocity[i] = newmark_velocity(local[i], state(local[i]));
-    for (unsigned q = 0; q < geo.points; ++q) {
-      for (unsigned i = 0; i < n; ++i) gradN[i] = Eigen::Map<const Eigen::Vector3d>(geo.gradient(c_index, q, geo.node_of_dof[i]));
-      // F = I + Grad u = I + Σ_a u_a e_c ⊗ Grad N_a (total Lagrangian: gradients with respect to
-      // the reference configuration)
-      Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
-      for (unsigned i = 0; i < n; ++i) F.row(comp[i]) += cell_u[i] * gradN[i].transpose();
-      const double JxW = geo.JxW[c_index * geo.points + q];
-      // The residual-only assemblies of the line search need P = F S alone (the same bits).
-      StressTangent st;
-      if (with_matrix) {
-        Eigen::Matrix3d S;
-        Tensor4 C4;
-        law.second_piola_and_tangent(F, S, C4);
-        st = first_piola_and_tangent(F, S, C4);
-      } else {
-        st.first_piola = F * law.second_piola(F);
-      }
-      if (damped) {
-        // Ḟ = Grad v = Σ_a v_a e_c ⊗ Grad N_a; P += P_v(F, Ḟ), 𝔸 += ∂P_v/∂F with ∂Ḟ/∂F = γ/(βh) = 2/h.
-        Eigen::Matrix3d F_rate = Eigen::Matrix3d::Zero();
-        for (unsigned i = 0; i < n; ++i) F_rate.row(comp[i]) += velocity[i] * gradN[i].transpose();
-        const StressTangent sv = kelvin_voigt_stress(damping[cell->material_id()], F, F_rate, 2.0 / dynamics->step);
-        st.first_piola += sv.first_piola;
-        if (with_matrix) st.tangent += sv.tangent;
-      }
-      // f_int,a = ∫ P : (e_c ⊗ Grad N_a) dV
-      for (unsigned i = 0; i < n; ++i) cell_int(i) += st.first_piola.row(comp[i]).dot(gradN[i]) * JxW;
-      if (!with_matrix) continue;
-      // K_ab = ∫ (e_ca ⊗ Grad N_a) : 𝔸 : (e_cb ⊗ Grad N_b) dV, by blocks of component pairs
-      // (cell_tangent.hpp); 𝔸 of a hyperelastic law has the major symmetry 𝔸_iJkL = 𝔸_kLiJ, so K
-      // is symmetric and half its blocks are mirrored (the Kelvin–Voigt tangent has no such
-      // symmetry: then every block).
-      const double* G = geo.gradient(c_index, q, 0);
-      if (geo.nodes == 4) tangent.add<4>(G, st.tangent, JxW, !damped);
-      else tangent.add<10>(G, st.tangent, JxW, !damped);
-    }
+    add_cell_stress(*this, c_index, law, damped ? &damping[cell->material_id()] : nullptr, cell_u, velocity, comp,
+                    with_matrix, gradN, tangent, cell_int);
     if (with_matrix) {
       if (!damped) tangent.complete_lower(static_cast<int>(geo.nodes));
       for (unsigned i = 0; i < n; ++i)
         for (unsigned j = 0; j < n; ++j) cell_K(i, j) += tangent(comp[i], comp[j])(node[i], node[j]);
     }
 
-    // Tractions and contact on boundary faces.
-    int near_tool = -1; // the cell's bound against the tool: -1 not tested yet, 0 outside, 1 may touch
-    for (const unsigned f : cell->face_indices()) {
-      if (!cell->face(f)->at_boundary()) continue;
-      const auto id = cell->face(f)->boundary_id();
-      Eigen::Vector3d traction_sum = Eigen::Vector3d::Zero();
-      const Eigen::Vector3d* traction = nullptr;
-      for (const auto& [group, t] : tractions)
-        if (in_group(id, group)) {
-          traction_sum += t;
-          traction = &traction_sum;
-        }
-      if (tool && near_tool < 0) near_tool = cell_outside_tool(local) ? 0 : 1;
-      const bool search = near_tool == 1;
-      if (traction == nullptr && !search) continue;
-      ffv.reinit(cell, f);
-      if (search) ffv[disp].get_function_values(state, face_u);
-      const Eigen::Vector3d side = search ? crack_side(cell, f) : Eigen::Vector3d::Zero();
-      for (unsigned q = 0; q < ffv.n_quadrature_points; ++q) {
-        const double JxW = ffv.JxW(q);
-        Eigen::Vector3d t = Eigen::Vector3d::Zero();
-        if (traction != nullptr) {
-          t += load.load_factor * *traction;
-          out.traction_on_body += load.load_factor * *traction * JxW;
-        }
-        Eigen::Matrix3d dt_dx = Eigen::Matrix3d::Zero();
-        if (search) {
-          const Eigen::Vector3d x = to_eigen(ffv.quadrature_point(q)) + Eigen::Vector3d(face_u[q][0], face_u[q][1], face_u[q][2]);
-          const ToolContactPoint c = tool_contact(*tool, load.tool_position, x, side);
-          if (c.inside) {
-            // t_c = ε_N p n (per unit reference area), p = −g
-            const Eigen::Vector3d tc = penalty * c.penetration * c.normal;
-            t += tc;
-            out.contact_on_body += tc * JxW;
-            ++out.contact_points;
-            out.contact_area += JxW;
-            out.max_pressure = std::max(out.max_pressure, penalty * c.penetration);
-            // Penalty energy ½ ε_N p² per reference area (its derivative is the traction above).
-            out.contact_energy += 0.5 * penalty * c.penetration * c.penetration * JxW;
-            // ∂t_c/∂x = ε_N (−n⊗n + p ∂n/∂x)
-            dt_dx = penalty * (-c.normal * c.normal.transpose() + c.penetration * c.normal_derivative);
-          }
-        }
-        for (unsigned i = 0; i < n; ++i) {
-          const double Ni = ffv.shape_value_component(i, q, comp[i]);
-          if (Ni == 0.0) continue;
-          cell_ext(i) += Ni * t[comp[i]] * JxW;
-          if (with_matrix && search)
-            for (unsigned j = 0; j < n; ++j)
-              cell_K(i, j) -= Ni * dt_dx(comp[i], comp[j]) * ffv.shape_value_component(j, q, comp[j]) * JxW;
-        }
-      }
-    }
+    add_boundary_faces(*this, cell, state, load, with_matrix, cell_outside_tool, comp, ffv, face_u, out, cell_ext, cell_K);
     f_int.add(local, cell_int);
     f_ext.add(local, cell_ext);
     if (with_matrix) {
