@@ -6,7 +6,6 @@
 
 #include <chrono>
 #include <cstdlib>
-#include <ctime>
 #include <stdexcept>
 #include <thread>
 
@@ -73,11 +72,6 @@ LiveViewReport run_live_view(ToolModel& model, const ToolModel& shown, const Tet
   using Clock = std::chrono::steady_clock;
   double render_total = 0.0;
   double render_cpu_total = 0.0;
-  auto thread_cpu_seconds = [] {
-    timespec t{};
-    ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-  };
   auto draw = [&] {
     if (!viewed.update()) return;
     const auto begin = Clock::now();

@@ -12,6 +12,7 @@
 
 #include "meshes/blade_shape.hpp"
 #include "meshes/box_tet_mesh.hpp"
+#include "realtime/haptics/realtime_scheduling.hpp"
 #include "realtime/springs/lattice_forces.hpp"
 #include "realtime/springs/network_embedding.hpp"
 #include "realtime/springs/network_system.hpp"
@@ -150,13 +151,6 @@ void gershgorin_cost(benchmark::State& state, bool lattice) {
   for (auto _ : state) benchmark::DoNotOptimize(lattice ? forces.gershgorin_bound(net, x) : gershgorin_frequency_bound(net, x, work));
 }
 
-/// CPU time of the calling thread [s] (the per-sample cost of the tear storm, on a shared machine).
-double thread_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
 /// A tear storm: clay_tear (experiments/scenes/clay_tear.toml) on a 24 x 8 x 8 box mesh of the
 /// 60 x 20 x 20 mm bar, test::clay_tear_setup (tests/realtime/springs/model_fixtures.hpp; 12 cells along it,
 /// h = 5 mm, styluses grasping the nodes within 7.5 mm, pulled apart at 5 mm/s each, tensile
@@ -186,10 +180,10 @@ void tear_storm(benchmark::State& state, SpringIntegrator integrator) {
       tools[0].position = {0.015 - d, 0.0, 0.022};
       tools[1].position = {0.045 + d, 0.0, 0.022};
       const int tears = model.tears();
-      const double t0 = thread_seconds();
+      const double t0 = thread_cpu_seconds();
       const auto w0 = std::chrono::steady_clock::now();
       model.step(tools, 1e-3, forces);
-      const double c = thread_seconds() - t0;
+      const double c = thread_cpu_seconds() - t0;
       wall.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count());
       cost.push_back(c);
       unconverged += forces[0].over_budget ? 1 : 0;
@@ -260,9 +254,9 @@ void blade_press(benchmark::State& state) {
     ForceSample force;
     for (const double zk : z) {
       tool.position = {0.02, 0.0, zk};
-      const double t0 = thread_seconds();
+      const double t0 = thread_cpu_seconds();
       model.step({&tool, 1}, 1e-3, {&force, 1});
-      cost.push_back(thread_seconds() - t0);
+      cost.push_back(thread_cpu_seconds() - t0);
       unconverged += force.over_budget ? 1 : 0;
     }
   }

@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <ctime>
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
@@ -32,23 +33,23 @@ bool pin_to_cpu(int cpu) noexcept {
 }
 
 CpuMask keep_off_cpu(int cpu) noexcept {
-  static_assert(sizeof(cpu_set_t) == sizeof(CpuMask::bits));
-  CpuMask saved;
-  cpu_set_t set;
-  CPU_ZERO(&set);
-  if (cpu < 0 || cpu >= CPU_SETSIZE || pthread_getaffinity_np(pthread_self(), sizeof set, &set) != 0) return saved;
-  if (!CPU_ISSET(cpu, &set) || CPU_COUNT(&set) < 2) return saved;
-  std::memcpy(saved.bits, &set, sizeof set);
-  CPU_CLR(cpu, &set);
-  saved.saved = pthread_setaffinity_np(pthread_self(), sizeof set, &set) == 0;
-  return saved;
+  CpuMask before;
+  if (cpu < 0 || cpu >= CPU_SETSIZE || pthread_getaffinity_np(pthread_self(), sizeof before.set, &before.set) != 0) return {};
+  if (!CPU_ISSET(cpu, &before.set) || CPU_COUNT(&before.set) < 2) return {};
+  cpu_set_t without = before.set;
+  CPU_CLR(cpu, &without);
+  before.saved = pthread_setaffinity_np(pthread_self(), sizeof without, &without) == 0;
+  return before;
 }
 
 void restore_cpus(const CpuMask& mask) noexcept {
-  if (!mask.saved) return;
-  cpu_set_t set;
-  std::memcpy(&set, mask.bits, sizeof set);
-  pthread_setaffinity_np(pthread_self(), sizeof set, &set);
+  if (mask.saved) pthread_setaffinity_np(pthread_self(), sizeof mask.set, &mask.set);
+}
+
+double thread_cpu_seconds() noexcept {
+  timespec t{};
+  ::clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
 RealtimeSetup enter_realtime(int priority, int cpu) noexcept {

@@ -3,6 +3,8 @@
 // process is permitted (root, CAP_SYS_NICE/CAP_IPC_LOCK, or rtprio/memlock limits), otherwise
 // the ordinary scheduler with a clear warning saying what was refused and why.
 
+#include <sched.h>
+
 #include <string>
 
 namespace kerf {
@@ -32,10 +34,14 @@ bool pin_to_cpu(int cpu) noexcept;
 /// nothing changes when `cpu` < 0 or it is the thread's only CPU.
 struct CpuMask {
   bool saved = false;
-  unsigned char bits[128] = {}; ///< cpu_set_t's bytes (1024 CPUs)
+  cpu_set_t set{};
 };
 CpuMask keep_off_cpu(int cpu) noexcept;
 void restore_cpus(const CpuMask& mask) noexcept;
+
+/// CPU time the calling thread has used [s] (CLOCK_THREAD_CPUTIME_ID): a cost measure that a
+/// preemption or a busy neighbour does not inflate.
+double thread_cpu_seconds() noexcept;
 
 /// Sets the calling thread's SCHED_FIFO priority only (for a second real-time thread). Returns
 /// false when refused.
