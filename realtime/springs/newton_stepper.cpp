@@ -51,6 +51,8 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_f.setZero(3, cap);
   m_zero.setZero(3, cap);
   m_x_before.setZero(3, cap);
+  m_x_factor.setZero(3, cap);
+  m_x_job.setZero(3, cap);
   m_free_entry.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_dof.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_mass.assign(3 * static_cast<std::size_t>(cap), 0.0);
@@ -91,6 +93,7 @@ bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x
     ok = active().factorize();
   }
   if (!ok) return false;
+  m_x_factor.leftCols(net.node_count) = x.leftCols(net.node_count);
   m_factor_dt = dt;
   m_factor_tangent = tangent;
   m_factor_mass_weight = wm;
@@ -122,13 +125,17 @@ bool NewtonStepper::retopologise(const SpringNetwork& net, const Eigen::Matrix3X
     int original = -1;
     for (int p = 0; p < first_copy && original < 0; ++p)
       if (net.rest.col(p) == net.rest.col(copy)) original = p;
+    if (original >= 0) {
+      m_x_factor.col(copy) = m_x_factor.col(original);
+      m_x_job.col(copy) = m_x_job.col(original);
+    }
     const long index = ++m_splits;
     RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)];
     r = RecordedSplit{index, original, copy,
                       original >= 0 ? net.mass[static_cast<std::size_t>(original)] + net.mass[static_cast<std::size_t>(copy)] : 0.0};
     // Full (or H singular): the kept factor stays uncorrected for this split until a refresh;
     // Newton then converges more slowly (and says so when it does not).
-    if (!correct_for_split(net, x, index)) m_uncorrected = true;
+    if (!correct_for_split(net, index)) m_uncorrected = true;
   }
   // A fresh factor of the torn network (if none is being computed: that one is corrected for
   // this split when adopted).
@@ -136,7 +143,7 @@ bool NewtonStepper::retopologise(const SpringNetwork& net, const Eigen::Matrix3X
   return true;
 }
 
-bool NewtonStepper::correct_for_split(const SpringNetwork& net, const Eigen::Matrix3Xd& x, long index) noexcept {
+bool NewtonStepper::correct_for_split(const SpringNetwork& net, long index) noexcept {
   const RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)];
   if (r.index != index || r.original < 0 || m_factor_dt < 0.0) return false;
   // The splits made after this one (when corrected for after them): their copies' corners are
@@ -147,7 +154,12 @@ bool NewtonStepper::correct_for_split(const SpringNetwork& net, const Eigen::Mat
     const RecordedSplit& l = m_recent[static_cast<std::size_t>(k % SplitCorrection::max_splits)];
     if (l.index == k) later[later_count++] = {l.copy, l.original};
   }
-  return m_correction.add(active(), net, x, r.original, r.copy, r.mass_before, m_factor_mass_weight, m_factor_stiffness_weight,
+  // The moved cells' stiffness where the kept matrix has the rest of the network's: taken at
+  // the positions now, the correction would remove from the original's rows a stiffness the
+  // kept matrix does not hold and leave a matrix of no one state (on clay_tear's pull, a
+  // factor adopted with ten splits to correct then stepped 1.2-6 times too far, 10-75 degrees
+  // off the torn network's own step, for the 16 samples until the next).
+  return m_correction.add(active(), net, m_x_factor, r.original, r.copy, r.mass_before, m_factor_mass_weight, m_factor_stiffness_weight,
                           m_factor_tangent, later, later_count);
 }
 
@@ -159,13 +171,14 @@ void NewtonStepper::request_refresh(const SpringNetwork& net, const Eigen::Matri
   if (m_refresh->start(*m_systems[static_cast<std::size_t>(1 - m_active)], net, x, wm, wk, m_splits,
                        m_tear_ready ? CellTangent::projected : CellTangent::exact, reanalyse)) {
     m_job_call = m_calls;
+    m_x_job.leftCols(net.node_count) = x.leftCols(net.node_count);
     m_job_dt = dt;
     m_job_mass_weight = wm;
     m_job_stiffness_weight = wk;
   }
 }
 
-void NewtonStepper::collect_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, NewtonReport& report) noexcept {
+void NewtonStepper::collect_refresh(const SpringNetwork& net, NewtonReport& report) noexcept {
   if (!m_refresh || !m_refresh->busy()) return;
   if (m_policy.delay >= 0) {
     if (m_calls < m_job_call + m_policy.delay) return;
@@ -176,6 +189,7 @@ void NewtonStepper::collect_refresh(const SpringNetwork& net, const Eigen::Matri
   const FactorRefresh::Result result = m_refresh->collect();
   if (!result.factorised) return;
   m_active = 1 - m_active;
+  m_x_factor.swap(m_x_job); // the snapshot's positions (a swap of buffers: no allocation)
   m_factor_dt = m_job_dt;
   m_factor_tangent = result.tangent;
   m_factor_mass_weight = m_job_mass_weight;
@@ -193,7 +207,7 @@ void NewtonStepper::collect_refresh(const SpringNetwork& net, const Eigen::Matri
   }
   if (result.tag < m_splits)
     for (long index = result.tag + 1; index <= m_splits; ++index)
-      if (!correct_for_split(net, x, index)) m_uncorrected = true;
+      if (!correct_for_split(net, index)) m_uncorrected = true;
 }
 
 void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
@@ -428,7 +442,7 @@ bool NewtonStepper::keep_factor_for(const SpringNetwork& net, const Eigen::Matri
     // A new dt, or splits the kept factor is only corrected for: a fresh factor (if none is
     // being computed already).
     request_refresh(net, x, dt);
-    collect_refresh(net, x, report);
+    collect_refresh(net, report);
   }
   return true;
 }
@@ -439,7 +453,7 @@ bool NewtonStepper::keep_factor_for(const SpringNetwork& net, const Eigen::Matri
 NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
                                              double dt) noexcept {
   NewtonReport report;
-  collect_refresh(net, x, report);
+  collect_refresh(net, report);
   const int n = net.node_count;
   const int m = m_free_count;
   m_x0.leftCols(n) = x.leftCols(n);

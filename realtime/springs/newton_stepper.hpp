@@ -127,10 +127,11 @@ private:
   /// Starts a refresh at positions x (if none is running).
   void request_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
   /// Adopts a finished refresh when the policy says so, corrected for the splits made since its
-  /// snapshot (x: the positions now); counts it in `report`.
-  void collect_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, NewtonReport& report) noexcept;
-  /// Corrects the kept factor for split number `index` (recorded by `retopologise`).
-  bool correct_for_split(const SpringNetwork& net, const Eigen::Matrix3Xd& x, long index) noexcept;
+  /// snapshot; counts it in `report`.
+  void collect_refresh(const SpringNetwork& net, NewtonReport& report) noexcept;
+  /// Corrects the kept factor for split number `index` (recorded by `retopologise`), with the
+  /// moved cells' stiffness at the kept matrix's positions (m_x_factor).
+  bool correct_for_split(const SpringNetwork& net, long index) noexcept;
   double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
                   LatticeForces::ForcePrecision precision = LatticeForces::ForcePrecision::double_precision) noexcept;
   NewtonReport advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
@@ -190,6 +191,11 @@ private:
   int m_calls_since_check = 0;    ///< linearly implicit: calls since the residual after the step was last checked
   double m_potential = 0.0;       ///< the incremental potential at the last residual evaluation [J]
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
+  /// The positions the kept factor's matrix was assembled at, and those of the refresh job's
+  /// snapshot; a copy made since sits at its original's place in both (its cells were the
+  /// original's there). A split's correction takes the moved cells' stiffness at the kept
+  /// matrix's own positions, so that the corrected matrix is the torn network's at one state.
+  Eigen::Matrix3Xd m_x_factor, m_x_job;
   Eigen::VectorXd m_r, m_dx;
   // Anderson mixing, per free entry: the iterate, its step, the previous ones, their differences.
   Eigen::VectorXd m_u, m_g, m_u_previous, m_g_previous, m_u_next;

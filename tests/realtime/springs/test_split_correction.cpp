@@ -7,6 +7,7 @@
 #include "tests/realtime/springs/network_fixtures.hpp"
 
 #include "realtime/springs/network_system.hpp"
+#include "realtime/springs/newton_stepper.hpp"
 #include "realtime/springs/split_correction.hpp"
 
 #include <gtest/gtest.h>
@@ -192,6 +193,66 @@ TEST(SplitRoom, DecoupledShadowsOfATornNetworkSolveLikeItsOwnSystemAndStayOutOfT
   EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), 1e-10 * expected.cwiseAbs().maxCoeff());
   // An unused shadow's equation is decoupled with a zero right-hand side: its solution is zero.
   for (int d = room.factor_dofs(); d < room.dof_count(); ++d) EXPECT_EQ(a[d], 0.0);
+}
+
+TEST(NewtonStepperSplit, KeptFactorIsCorrectedAtTheStateItWasAssembledAt) {
+  // The kept factor is assembled at one state (the block at rest) and a vertex split is made at
+  // another (the block's top sheared by 20 % of its height along x and 10 % along y, where its
+  // springs' lateral stiffness (1 − L/l) k is far from the zero it has at rest). The correction
+  // makes the kept factor exact for the new topology at the kept factor's own state, so the
+  // stepper's first step after the split must be the one a factor of the torn network at that
+  // state gives: the second method is a stepper built on the torn network and primed there.
+  // Taking the moved cells' stiffness at the state of the split instead would remove from the
+  // original's rows a stiffness the kept matrix never held (a matrix of no one state).
+  Block block;
+  const SpringNetwork& net = block.net;
+  const double dt = block.dt, height = 4 * block.h;
+  const Eigen::Matrix3Xd at_rest = net.rest;
+  Eigen::Matrix3Xd sheared = net.rest;
+  for (int n = 0; n < net.node_count; ++n) {
+    const double z = net.rest(2, n) - net.block.origin.z();
+    sheared(0, n) += 0.2 * z * z / height;
+    sheared(1, n) += 0.1 * z * z / height;
+  }
+  FactorRefreshPolicy policy;
+  policy.delay = 1000; // no fresh factor is adopted within the test: the kept one steps
+  const int copy = net.node_count;
+  SpringNetwork torn = net;
+  const int original = split_at(torn, Eigen::Vector3i(2, 2, 2), 0);
+  ASSERT_GE(original, 0);
+  const auto with_copy = [&](Eigen::Matrix3Xd x) {
+    x.col(copy) = x.col(original);
+    return x;
+  };
+  const Eigen::Matrix3Xd start = with_copy(sheared);
+  const Eigen::Matrix3Xd zero = Eigen::Matrix3Xd::Zero(3, start.cols());
+
+  NewtonStepper kept(net, NewtonStepper::Mode::implicit_euler, 1, 1e-5, true, policy);
+  ASSERT_TRUE(kept.prime(net, at_rest, dt));
+  Eigen::Matrix3Xd x = start, v = zero;
+  ASSERT_TRUE(kept.retopologise(torn, x));
+  const NewtonReport report = kept.advance(torn, x, v, dt);
+  EXPECT_EQ(report.factorisations, 0); // the kept factor, corrected: nothing factorised here
+
+  NewtonStepper fresh(torn, NewtonStepper::Mode::implicit_euler, 1, 1e-5, true, policy);
+  ASSERT_TRUE(fresh.prime(torn, with_copy(at_rest), dt));
+  Eigen::Matrix3Xd xf = start, vf = zero;
+  fresh.advance(torn, xf, vf, dt);
+
+  // The same step to single precision's reach (both factors are read in single precision).
+  const int n = torn.node_count;
+  const Eigen::Matrix3Xd step = x.leftCols(n) - start.leftCols(n), expected = xf.leftCols(n) - start.leftCols(n);
+  const double scale = expected.cwiseAbs().maxCoeff();
+  ASSERT_GT(scale, 0.0);
+  EXPECT_LT((step - expected).cwiseAbs().maxCoeff(), 1e-4 * scale);
+
+  // The states are far enough apart to tell: the torn network's factor at the sheared state
+  // steps differently by far more than that.
+  NewtonStepper now(torn, NewtonStepper::Mode::implicit_euler, 1, 1e-5, true, policy);
+  ASSERT_TRUE(now.prime(torn, start, dt));
+  Eigen::Matrix3Xd xn = start, vn = zero;
+  now.advance(torn, xn, vn, dt);
+  EXPECT_GT((xn.leftCols(n) - xf.leftCols(n)).cwiseAbs().maxCoeff(), 1e-2 * scale);
 }
 
 } // namespace
