@@ -69,7 +69,7 @@ void FactorRefresh::work() {
     bool ok = true;
     if (m_reanalyse) {
       try {
-        system.rebuild(m_net, NetworkSystem::SplitRoom::decoupled_shadows);
+        system.rebuild(m_net, NetworkSystem::SplitRoom::decoupled_shadows, false); // factorised below
       } catch (const std::exception&) {
         ok = false; // off the lattice or CHOLMOD out of memory: no factor this time
       }

@@ -7,6 +7,7 @@
 #include "realtime/springs/vector_clones.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -76,9 +77,81 @@ std::array<int, 2> cell_dofs(const SpringNetwork& net, const std::vector<int>& m
 
 /// The lower triangle of the n x n cell-coupling pattern (every pair of dofs, or coupled
 /// shadows, of nodes sharing a cell) with dofs numbered by `map` and `shadow`, and the diagonal
-/// of decoupled shadows; entries 1.
+/// of decoupled shadows; entries 1. Built node by node: the dofs of the nodes sharing a cell
+/// with node q, sorted once, are the rows of each of q's columns from that column down (every
+/// column belongs to one node), so no entry is produced twice and nothing is sorted but those
+/// short lists.
 NetworkSystem::Matrix lower_pattern(const SpringNetwork& net, const std::vector<int>& map, const std::vector<int>& shadow, int n,
                                     NetworkSystem::SplitRoom room) {
+  const bool coupled = room == NetworkSystem::SplitRoom::coupled_shadows;
+  const int nodes = net.node_count;
+  // Each node's cells, as compressed rows.
+  std::vector<int> first_cell(static_cast<std::size_t>(nodes) + 1, 0), cells;
+  for (const auto& corners : net.cell_nodes)
+    for (const int p : corners) ++first_cell[static_cast<std::size_t>(p) + 1];
+  for (int p = 0; p < nodes; ++p) first_cell[static_cast<std::size_t>(p) + 1] += first_cell[static_cast<std::size_t>(p)];
+  cells.resize(static_cast<std::size_t>(first_cell.back()));
+  {
+    std::vector<int> next(first_cell.begin(), first_cell.end() - 1);
+    for (int c = 0; c < net.cell_count(); ++c)
+      for (const int p : net.cell_nodes[static_cast<std::size_t>(c)]) cells[static_cast<std::size_t>(next[static_cast<std::size_t>(p)]++)] = c;
+  }
+  // A node's dofs: its axes' and, with coupled shadows, their shadows'.
+  const auto add_dofs = [&](int p, std::vector<int>& out) {
+    for (int i = 0; i < 3; ++i) {
+      const auto k = static_cast<std::size_t>(3 * p + i);
+      if (map[k] >= 0) out.push_back(map[k]);
+      if (coupled && shadow[k] >= 0) out.push_back(shadow[k]);
+    }
+  };
+  // Per node, the sorted dofs of the nodes sharing a cell with it (itself included).
+  std::vector<int> first_row(static_cast<std::size_t>(nodes) + 1, 0), rows, seen(static_cast<std::size_t>(nodes), -1), own;
+  rows.reserve(static_cast<std::size_t>(nodes) * 81);
+  for (int q = 0; q < nodes; ++q) {
+    const auto begin = static_cast<std::ptrdiff_t>(rows.size());
+    for (int k = first_cell[static_cast<std::size_t>(q)]; k < first_cell[static_cast<std::size_t>(q) + 1]; ++k)
+      for (const int p : net.cell_nodes[static_cast<std::size_t>(cells[static_cast<std::size_t>(k)])])
+        if (seen[static_cast<std::size_t>(p)] != q) {
+          seen[static_cast<std::size_t>(p)] = q;
+          add_dofs(p, rows);
+        }
+    std::sort(rows.begin() + begin, rows.end());
+    first_row[static_cast<std::size_t>(q) + 1] = static_cast<int>(rows.size());
+  }
+  // Column c of node q: q's rows from c down; a decoupled shadow's column: its diagonal.
+  std::vector<int> node_of_column(static_cast<std::size_t>(n), -1);
+  for (int q = 0; q < nodes; ++q) {
+    own.clear();
+    add_dofs(q, own);
+    for (const int c : own) node_of_column[static_cast<std::size_t>(c)] = q;
+  }
+  const bool decoupled = room == NetworkSystem::SplitRoom::decoupled_shadows;
+  std::vector<std::uint8_t> shadow_column(static_cast<std::size_t>(n), 0);
+  if (decoupled)
+    for (const int d : shadow)
+      if (d >= 0) shadow_column[static_cast<std::size_t>(d)] = 1;
+  NetworkSystem::Matrix m(n, n);
+  std::vector<int> outer(static_cast<std::size_t>(n) + 1, 0), inner;
+  for (int c = 0; c < n; ++c) {
+    if (const int q = node_of_column[static_cast<std::size_t>(c)]; q >= 0) {
+      const int* begin = rows.data() + first_row[static_cast<std::size_t>(q)];
+      const int* end = rows.data() + first_row[static_cast<std::size_t>(q) + 1];
+      inner.insert(inner.end(), std::lower_bound(begin, end, c), end);
+    }
+    if (shadow_column[static_cast<std::size_t>(c)]) inner.push_back(c);
+    outer[static_cast<std::size_t>(c) + 1] = static_cast<int>(inner.size());
+  }
+  m.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
+  std::copy(outer.begin(), outer.end(), m.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), m.innerIndexPtr());
+  std::fill(m.valuePtr(), m.valuePtr() + inner.size(), 1.0);
+  return m;
+}
+
+/// The same pattern from every cell's pairs of dofs, as triplets: the second method `rebuild`
+/// checks the pattern above against where assertions are on (the sanitizer builds).
+[[maybe_unused]] NetworkSystem::Matrix lower_pattern_by_triplets(const SpringNetwork& net, const std::vector<int>& map,
+                                                                 const std::vector<int>& shadow, int n, NetworkSystem::SplitRoom room) {
   const bool coupled = room == NetworkSystem::SplitRoom::coupled_shadows;
   const std::vector<int> none(coupled ? 0 : shadow.size(), -1);
   const std::vector<int>& coupled_shadow = coupled ? shadow : none;
@@ -99,6 +172,13 @@ NetworkSystem::Matrix lower_pattern(const SpringNetwork& net, const std::vector<
   m.setFromTriplets(triplets.begin(), triplets.end());
   m.makeCompressed();
   return m;
+}
+
+/// Whether a and b have the same entries (compressed, rows sorted in each column).
+[[maybe_unused]] bool same_pattern(const NetworkSystem::Matrix& a, const NetworkSystem::Matrix& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && a.nonZeros() == b.nonZeros() &&
+         std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.cols() + 1, b.outerIndexPtr()) &&
+         std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr());
 }
 
 /// Fill-reducing ordering of the first `n` natural dofs (those in the factor): the lattice's
@@ -230,7 +310,7 @@ double NetworkSystem::factor_entries() const {
   return (m_factor->is_super ? static_cast<double>(m_factor->xsize) : static_cast<double>(m_factor->nzmax)) + (dof_count() - m_factor_dofs);
 }
 
-void NetworkSystem::rebuild(const SpringNetwork& net, SplitRoom room) {
+void NetworkSystem::rebuild(const SpringNetwork& net, SplitRoom room, bool check_mass) {
   release();
   m_factorized = false;
   m_room = room;
@@ -241,6 +321,7 @@ void NetworkSystem::rebuild(const SpringNetwork& net, SplitRoom room) {
   const int n = dofs.count;
   m_factor_dofs = room == SplitRoom::decoupled_shadows ? dofs.first_shadow : n;
   m_matrix = lower_pattern(net, dofs.natural, dofs.shadow_natural, n, room);
+  assert(same_pattern(m_matrix, lower_pattern_by_triplets(net, dofs.natural, dofs.shadow_natural, n, room)));
   m_bound_cells = net.cell_nodes;
   m_bound_nodes = net.node_count;
   m_shadow_of.assign(dofs.natural.size(), -1);
@@ -259,12 +340,14 @@ void NetworkSystem::rebuild(const SpringNetwork& net, SplitRoom room) {
 
   // Lower-triangular pattern in the factor's order, and each cell entry's place in it.
   m_matrix = lower_pattern(net, m_dof_of, m_shadow_of, n, room);
+  assert(same_pattern(m_matrix, lower_pattern_by_triplets(net, m_dof_of, m_shadow_of, n, room)));
   m_entry.assign(static_cast<std::size_t>(net.cell_count()) * 576, -1);
   for (int cell = 0; cell < net.cell_count(); ++cell) bind_cell(net, cell);
   m_diagonal.assign(static_cast<std::size_t>(n), -1);
   for (int k = 0; k < n; ++k) m_diagonal[static_cast<std::size_t>(k)] = value_index(k, k);
 
   size_solve_workspaces();
+  if (!check_mass) return;
   // One factorisation of the mass matrix, which must succeed (positive lumped masses).
   assemble(net, net.rest, 1.0, 0.0);
   if (!factorize()) throw std::runtime_error("NetworkSystem: the lumped mass matrix did not factorise");

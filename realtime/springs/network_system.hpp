@@ -75,7 +75,10 @@ public:
     /// `rebuild` (`factorize` says false until then). The factor is the network's own size.
     decoupled_shadows
   };
-  void rebuild(const SpringNetwork& net, SplitRoom room);
+  /// `check_mass`: end with a factorisation of the lumped mass matrix, which must succeed (a
+  /// check that every mass is positive); false for a caller that assembles and factorises the
+  /// system next anyway (the factor refresh's worker), which then makes that check.
+  void rebuild(const SpringNetwork& net, SplitRoom room, bool check_mass = true);
 
   /// After vertex splits on a system with room for them: gives each new node (a copy) its
   /// original's shadow dofs and, with coupled shadows, re-places the entries of the cells whose
