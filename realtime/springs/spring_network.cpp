@@ -1,7 +1,5 @@
 #include "realtime/springs/spring_network.hpp"
 
-#include "realtime/springs/vector_clones.hpp"
-
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
@@ -238,43 +236,6 @@ void cell_stiffness_matrix(const SpringNetwork& net, int cell, const Eigen::Matr
   }
 }
 
-namespace {
-
-/// Springs [first, first + n) (n <= spring_chunk) of `s`: each one's difference vector e = x_b −
-/// x_a, its force scale c (f_a = c e, f_b = −c e) and its stored energy ½ k (l − L)², into the
-/// chunk's arrays. No spring writes another's entries, so the loop vectorises (gathers of the
-/// ends' coordinates; square root and division lane by lane); without contraction into fused
-/// multiply-adds (fp-contract=off, which the AVX2 and AVX-512 clones would otherwise do) each
-/// lane rounds as the one-spring-at-a-time loop did, so the forces are that loop's to the bit.
-/// The sums over springs are left to the caller, in spring order.
-constexpr int spring_chunk = 64;
-struct SpringChunk {
-  double ex[spring_chunk], ey[spring_chunk], ez[spring_chunk], scale[spring_chunk], energy[spring_chunk];
-};
-
-KERF_VECTOR_CLONES [[gnu::optimize("fp-contract=off")]]
-void spring_chunk_terms(const SpringArrays& s, int first, int n, const double* xd, const double* vd, double tau, double tiny,
-                        SpringChunk& out) noexcept {
-  const int* sa = s.a.data() + first;
-  const int* sb = s.b.data() + first;
-  const double* sk = s.k.data() + first;
-  const double* sl = s.rest.data() + first;
-  for (int i = 0; i < n; ++i) {
-    const int a = 3 * sa[i], b = 3 * sb[i];
-    const double ex = xd[b] - xd[a], ey = xd[b + 1] - xd[a + 1], ez = xd[b + 2] - xd[a + 2];
-    const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
-    const double inv_l = l > tiny ? 1.0 / l : 0.0; // coincident ends: no direction, no force
-    const double stretch = l - sl[i];
-    const double rate = (vd[b] - vd[a]) * ex + (vd[b + 1] - vd[a + 1]) * ey + (vd[b + 2] - vd[a + 2]) * ez;
-    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
-    out.scale[i] = sk[i] * (stretch + tau * rate * inv_l) * inv_l;
-    out.ex[i] = ex, out.ey[i] = ey, out.ez[i] = ez;
-    out.energy[i] = 0.5 * sk[i] * stretch * stretch * (inv_l > 0.0 ? 1.0 : 0.0);
-  }
-}
-
-} // namespace
-
 double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                       Eigen::Matrix3Xd& f) noexcept {
   f.leftCols(net.node_count).setZero();
@@ -287,19 +248,20 @@ double network_forces(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const
   const SpringArrays& s = net.springs;
   const int* sa = s.a.data();
   const int* sb = s.b.data();
-  // The springs' terms a chunk at a time (vectorised), then their forces added and energies
-  // summed in spring order (the sums as one spring at a time would make them).
-  SpringChunk chunk;
-  for (int first = 0; first < s.count; first += spring_chunk) {
-    const int n = std::min(spring_chunk, s.count - first);
-    spring_chunk_terms(s, first, n, xd, vd, tau, tiny, chunk);
-    for (int j = 0; j < n; ++j) {
-      const int a = 3 * sa[first + j], b = 3 * sb[first + j];
-      const double c = chunk.scale[j], ex = chunk.ex[j], ey = chunk.ey[j], ez = chunk.ez[j];
-      fd[a] += c * ex, fd[a + 1] += c * ey, fd[a + 2] += c * ez;
-      fd[b] -= c * ex, fd[b + 1] -= c * ey, fd[b + 2] -= c * ez;
-      energy += chunk.energy[j];
-    }
+  const double* sk = s.k.data();
+  const double* sl = s.rest.data();
+  for (int i = 0; i < s.count; ++i) {
+    const int a = 3 * sa[i], b = 3 * sb[i];
+    const double ex = xd[b] - xd[a], ey = xd[b + 1] - xd[a + 1], ez = xd[b + 2] - xd[a + 2];
+    const double l = std::sqrt(ex * ex + ey * ey + ez * ez);
+    const double inv_l = l > tiny ? 1.0 / l : 0.0; // coincident ends: no direction, no force
+    const double stretch = l - sl[i];
+    const double rate = (vd[b] - vd[a]) * ex + (vd[b + 1] - vd[a + 1]) * ey + (vd[b + 2] - vd[a + 2]) * ez;
+    // f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = e / l
+    const double scale = sk[i] * (stretch + tau * rate * inv_l) * inv_l;
+    fd[a] += scale * ex, fd[a + 1] += scale * ey, fd[a + 2] += scale * ez;
+    fd[b] -= scale * ex, fd[b + 1] -= scale * ey, fd[b + 2] -= scale * ez;
+    energy += 0.5 * sk[i] * stretch * stretch * (inv_l > 0.0 ? 1.0 : 0.0);
   }
   const double kappa = net.stiffness.volume_modulus;
   if (kappa > 0.0) {
