@@ -135,7 +135,7 @@ bool NewtonStepper::retopologise(const SpringNetwork& net, const Eigen::Matrix3X
                       original >= 0 ? net.mass[static_cast<std::size_t>(original)] + net.mass[static_cast<std::size_t>(copy)] : 0.0};
     // Full (or H singular): the kept factor stays uncorrected for this split until a refresh;
     // Newton then converges more slowly (and says so when it does not).
-    if (!correct_for_split(net, index, copy + 1 == net.node_count)) m_uncorrected = true;
+    if (!correct_for_split(net, index)) m_uncorrected = true;
   }
   // A fresh factor of the torn network (if none is being computed: that one is corrected for
   // this split when adopted).
@@ -143,7 +143,7 @@ bool NewtonStepper::retopologise(const SpringNetwork& net, const Eigen::Matrix3X
   return true;
 }
 
-bool NewtonStepper::correct_for_split(const SpringNetwork& net, long index, bool last) noexcept {
+bool NewtonStepper::correct_for_split(const SpringNetwork& net, long index) noexcept {
   const RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)];
   if (r.index != index || r.original < 0 || m_factor_dt < 0.0) return false;
   // The splits made after this one (when corrected for after them): their copies' corners are
@@ -160,7 +160,7 @@ bool NewtonStepper::correct_for_split(const SpringNetwork& net, long index, bool
   // factor adopted with ten splits to correct then stepped 1.2-6 times too far, 10-75 degrees
   // off the torn network's own step, for the 16 samples until the next).
   return m_correction.add(active(), net, m_x_factor, r.original, r.copy, r.mass_before, m_factor_mass_weight, m_factor_stiffness_weight,
-                          m_factor_tangent, later, later_count, last);
+                          m_factor_tangent, later, later_count);
 }
 
 void NewtonStepper::request_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
@@ -207,7 +207,7 @@ void NewtonStepper::collect_refresh(const SpringNetwork& net, NewtonReport& repo
   }
   if (result.tag < m_splits)
     for (long index = result.tag + 1; index <= m_splits; ++index)
-      if (!correct_for_split(net, index, index == m_splits)) m_uncorrected = true;
+      if (!correct_for_split(net, index)) m_uncorrected = true;
 }
 
 void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {

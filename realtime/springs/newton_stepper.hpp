@@ -130,9 +130,8 @@ private:
   /// snapshot; counts it in `report`.
   void collect_refresh(const SpringNetwork& net, NewtonReport& report) noexcept;
   /// Corrects the kept factor for split number `index` (recorded by `retopologise`), with the
-  /// moved cells' stiffness at the kept matrix's positions (m_x_factor); `last`: the last of the
-  /// splits corrected for in a row (only its H is factorised, SplitCorrection::add).
-  bool correct_for_split(const SpringNetwork& net, long index, bool last = true) noexcept;
+  /// moved cells' stiffness at the kept matrix's positions (m_x_factor).
+  bool correct_for_split(const SpringNetwork& net, long index) noexcept;
   double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
                   LatticeForces::ForcePrecision precision = LatticeForces::ForcePrecision::double_precision) noexcept;
   NewtonReport advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;

@@ -37,7 +37,7 @@ void SplitCorrection::column_of_w(int split, int j, float* v) const noexcept {
 
 bool SplitCorrection::add(NetworkSystem& system, const SpringNetwork& net, const Eigen::Matrix3Xd& x, int original, int copy,
                           double mass_before, double mass_weight, double stiffness_weight, CellTangent tangent,
-                          const NodePair* later, int later_count, bool factorise) noexcept {
+                          const NodePair* later, int later_count) noexcept {
   if (m_splits == 0) m_dofs = system.dof_count(); // a system of its own numbering since `clear`
   if (full() || m_dofs != system.dof_count() || m_dofs > m_capacity) return false;
   const std::vector<int>& dof = system.dof_of();
@@ -150,22 +150,14 @@ bool SplitCorrection::add(NetworkSystem& system, const SpringNetwork& net, const
     m_c(first + k, first + 2 * s.r + k) = m_c(first + 2 * s.r + k, first + k) = -1.0;
     m_c(first + s.r + k, first + 2 * s.r + k) = m_c(first + 2 * s.r + k, first + s.r + k) = 1.0;
   }
-  if (!factorise) {
-    m_columns = m;
-    ++m_splits;
-    m_h_pending = true;
-    return true;
-  }
   if (!factor_h(m)) {
     // Singular with this split: left out, and H of the splits before it factorised again (the
-    // attempt overwrote it), or, if that is singular too, no split corrected for.
+    // attempt overwrote it in place, and later solves read it).
     if (first > 0 && !factor_h(first)) clear();
-    m_h_pending = false;
     return false;
   }
   m_columns = m;
   ++m_splits;
-  m_h_pending = false;
   return true;
 }
 
@@ -217,10 +209,6 @@ void SplitCorrection::solve_h(double* x) const noexcept {
 }
 
 void SplitCorrection::solve(NetworkSystem& system, const Eigen::VectorXd& rhs, Eigen::VectorXd& out) noexcept {
-  if (m_h_pending) {
-    m_h_pending = false;
-    if (!factor_h(m_columns)) clear();
-  }
   if (m_columns == 0) {
     system.solve(rhs, out);
     return;

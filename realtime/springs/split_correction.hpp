@@ -49,7 +49,7 @@ public:
   /// `clear` takes the size of the system it corrects.
   void reserve(int dofs);
   /// No split pending: the kept factor is exact for the topology.
-  void clear() noexcept { m_splits = m_columns = 0, m_h_pending = false; }
+  void clear() noexcept { m_splits = 0; m_columns = 0; }
   [[nodiscard]] int splits() const noexcept { return m_splits; }
   [[nodiscard]] bool full() const noexcept { return m_splits >= max_splits; }
 
@@ -60,8 +60,6 @@ public:
   /// matrix's own). False (nothing added) when full or when H is singular; then the splits
   /// added before stay corrected for, or, if H of those alone is singular too, none does.
   /// Allocation-free.
-  /// `factorise`: false to leave H's factorisation to the next split added (several splits in a
-  /// row: only the last one's H is ever solved with) or to `solve`.
   /// `later` lists the splits made after this one, as (copy, original) node pairs (a split
   /// corrected for after later ones, when a factor assembled before it is adopted): the cells are
   /// then taken with those copies' corners back at their originals, as they were at this split.
@@ -70,7 +68,7 @@ public:
   };
   bool add(NetworkSystem& system, const SpringNetwork& net, const Eigen::Matrix3Xd& x, int original, int copy,
            double mass_before, double mass_weight, double stiffness_weight, CellTangent tangent,
-           const NodePair* later = nullptr, int later_count = 0, bool factorise = true) noexcept;
+           const NodePair* later = nullptr, int later_count = 0) noexcept;
 
   /// out = (P + W C Wᵀ)⁻¹ rhs with the kept factor P of `system`: one forward and one backward
   /// substitution, and with pending splits two products with F's reached rows between them.
@@ -99,7 +97,6 @@ private:
   int m_dofs = 0;     ///< dofs of the system corrected
   int m_splits = 0;
   int m_columns = 0;
-  bool m_h_pending = false; ///< H is not factorised for the splits held (`add` without `factorise`)
   Split m_split[max_splits];
   std::vector<float> m_f;       ///< F = L⁻¹ W, column j at j (dofs + 16)
   /// Per split, the column ranges [begin, end) of the supernodes its F columns reach (at most

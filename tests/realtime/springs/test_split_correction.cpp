@@ -260,7 +260,6 @@ TEST(SplitCorrection, ASplitItCannotTakeLeavesTheSplitsBeforeItCorrectedFor) {
   // Two splits corrected for, then a third whose H cannot be factorised (a mass that is not a
   // number makes H not finite): `add` refuses it, and the correction must solve as one that
   // holds the first two alone (the second method) — the refused attempt factorised H in place.
-  // The same when the first two were added without factorising H (splits corrected in a row).
   const Block block;
   const double wm = 1.0 / (block.dt * block.dt), wk = 1.02;
   SpringNetwork torn = block.net;
@@ -281,30 +280,28 @@ TEST(SplitCorrection, ASplitItCannotTakeLeavesTheSplitsBeforeItCorrectedFor) {
     made[n++] = {copy, original};
   }
   ASSERT_TRUE(kept.bind_split_vertices(torn));
-  const auto add = [&](SplitCorrection& c, int k, double mass_before, bool factorise) {
+  const auto add = [&](SplitCorrection& c, int k, double mass_before) {
     return c.add(kept, torn, xt, made[k].original, made[k].copy, mass_before, wm, wk, CellTangent::projected, made + k + 1,
-                 2 - k, factorise);
+                 2 - k);
   };
   SplitCorrection two;
   two.reserve(kept.dof_count());
-  ASSERT_TRUE(add(two, 0, before[0], true));
-  ASSERT_TRUE(add(two, 1, before[1], true));
+  ASSERT_TRUE(add(two, 0, before[0]));
+  ASSERT_TRUE(add(two, 1, before[1]));
   std::mt19937 rng(13);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Eigen::VectorXd b(kept.dof_count()), expected(kept.dof_count()), got(kept.dof_count());
   for (int d = 0; d < kept.dof_count(); ++d) b[d] = d < kept.factor_dofs() ? u(rng) : 0.0;
   two.solve(kept, b, expected);
   ASSERT_TRUE(expected.allFinite());
-  for (const bool factorise_first : {true, false}) {
-    SplitCorrection three;
-    three.reserve(kept.dof_count());
-    ASSERT_TRUE(add(three, 0, before[0], factorise_first));
-    ASSERT_TRUE(add(three, 1, before[1], factorise_first));
-    EXPECT_FALSE(add(three, 2, std::numeric_limits<double>::quiet_NaN(), true));
-    EXPECT_EQ(three.splits(), 2);
-    three.solve(kept, b, got);
-    EXPECT_EQ((got - expected).cwiseAbs().maxCoeff(), 0.0) << "first two factorised: " << factorise_first;
-  }
+  SplitCorrection three;
+  three.reserve(kept.dof_count());
+  ASSERT_TRUE(add(three, 0, before[0]));
+  ASSERT_TRUE(add(three, 1, before[1]));
+  EXPECT_FALSE(add(three, 2, std::numeric_limits<double>::quiet_NaN()));
+  EXPECT_EQ(three.splits(), 2);
+  three.solve(kept, b, got);
+  EXPECT_EQ((got - expected).cwiseAbs().maxCoeff(), 0.0);
 }
 
 } // namespace
