@@ -63,6 +63,9 @@ public:
   void wait() const noexcept;
   /// After `finished`: the job's result; the refresh is idle again.
   Result collect() noexcept;
+  /// The positions the last started job was assembled at (its snapshot of `x`, node_count
+  /// columns of the snapshot's network); read it after `collect`, before the next `start`.
+  [[nodiscard]] const Eigen::Matrix3Xd& positions() const noexcept { return m_x; }
 
 private:
   enum State : int { idle = 0, requested = 1, done = 2, stopping = 3 };

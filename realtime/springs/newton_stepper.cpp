@@ -52,7 +52,6 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_zero.setZero(3, cap);
   m_x_before.setZero(3, cap);
   m_x_factor.setZero(3, cap);
-  m_x_job.setZero(3, cap);
   m_free_entry.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_dof.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_mass.assign(3 * static_cast<std::size_t>(cap), 0.0);
@@ -125,10 +124,7 @@ bool NewtonStepper::retopologise(const SpringNetwork& net, const Eigen::Matrix3X
     int original = -1;
     for (int p = 0; p < first_copy && original < 0; ++p)
       if (net.rest.col(p) == net.rest.col(copy)) original = p;
-    if (original >= 0) {
-      m_x_factor.col(copy) = m_x_factor.col(original);
-      m_x_job.col(copy) = m_x_job.col(original);
-    }
+    if (original >= 0) m_x_factor.col(copy) = m_x_factor.col(original);
     const long index = ++m_splits;
     RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)];
     r = RecordedSplit{index, original, copy,
@@ -171,7 +167,6 @@ void NewtonStepper::request_refresh(const SpringNetwork& net, const Eigen::Matri
   if (m_refresh->start(*m_systems[static_cast<std::size_t>(1 - m_active)], net, x, wm, wk, m_splits,
                        m_tear_ready ? CellTangent::projected : CellTangent::exact, reanalyse)) {
     m_job_call = m_calls;
-    m_x_job.leftCols(net.node_count) = x.leftCols(net.node_count);
     m_job_dt = dt;
     m_job_mass_weight = wm;
     m_job_stiffness_weight = wk;
@@ -189,7 +184,6 @@ void NewtonStepper::collect_refresh(const SpringNetwork& net, NewtonReport& repo
   const FactorRefresh::Result result = m_refresh->collect();
   if (!result.factorised) return;
   m_active = 1 - m_active;
-  m_x_factor.swap(m_x_job); // the snapshot's positions (a swap of buffers: no allocation)
   m_factor_dt = m_job_dt;
   m_factor_tangent = result.tangent;
   m_factor_mass_weight = m_job_mass_weight;
@@ -205,9 +199,13 @@ void NewtonStepper::collect_refresh(const SpringNetwork& net, NewtonReport& repo
     bind_free_entries(net);
     m_r.setZero();
   }
-  if (result.tag < m_splits)
-    for (long index = result.tag + 1; index <= m_splits; ++index)
-      if (!correct_for_split(net, index)) m_uncorrected = true;
+  // The snapshot's positions, with the copies made since at their originals' places.
+  m_x_factor.leftCols(net.node_count) = m_refresh->positions().leftCols(net.node_count);
+  for (long index = result.tag + 1; index <= m_splits; ++index)
+    if (const RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)]; r.index == index && r.original >= 0)
+      m_x_factor.col(r.copy) = m_x_factor.col(r.original);
+  for (long index = result.tag + 1; index <= m_splits; ++index)
+    if (!correct_for_split(net, index)) m_uncorrected = true;
 }
 
 void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {

@@ -191,11 +191,11 @@ private:
   int m_calls_since_check = 0;    ///< linearly implicit: calls since the residual after the step was last checked
   double m_potential = 0.0;       ///< the incremental potential at the last residual evaluation [J]
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
-  /// The positions the kept factor's matrix was assembled at, and those of the refresh job's
-  /// snapshot; a copy made since sits at its original's place in both (its cells were the
-  /// original's there). A split's correction takes the moved cells' stiffness at the kept
-  /// matrix's own positions, so that the corrected matrix is the torn network's at one state.
-  Eigen::Matrix3Xd m_x_factor, m_x_job;
+  /// The positions the kept factor's matrix was assembled at; a copy made since sits at its
+  /// original's place (its cells were the original's there). A split's correction takes the
+  /// moved cells' stiffness at the kept matrix's own positions, so that the corrected matrix is
+  /// the torn network's at one state.
+  Eigen::Matrix3Xd m_x_factor;
   Eigen::VectorXd m_r, m_dx;
   // Anderson mixing, per free entry: the iterate, its step, the previous ones, their differences.
   Eigen::VectorXd m_u, m_g, m_u_previous, m_g_previous, m_u_next;
