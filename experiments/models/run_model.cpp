@@ -37,6 +37,7 @@ ForceProfile run_model(ToolModel& model, const std::vector<std::string>& tool_na
     model.step(states, dt, forces);
     const auto end = std::chrono::steady_clock::now();
     const double cost = std::chrono::duration<double>(end - begin).count();
+    if (std::any_of(forces.begin(), forces.end(), [](const ForceSample& f) { return f.over_budget; })) ++profile.steps_over_budget;
     for (std::size_t i = 0; i < tools; ++i) {
       ProfileRow r;
       r.t = states[i].time;

@@ -14,7 +14,8 @@ namespace kerf {
 
 /// Steps `model` through the sampled trajectories (one per tool, same rate; a shorter one holds
 /// its last state) and returns the profile, one row per tool per sample. Each row's cost_s is
-/// the wall time of the model step that produced it (steady_clock). Throws
+/// the wall time of the model step that produced it (steady_clock); the profile counts the steps
+/// the model reported over budget (ForceProfile::steps_over_budget). Throws
 /// std::invalid_argument if the tool count or rates do not match.
 ForceProfile run_model(ToolModel& model, const std::vector<std::string>& tool_names,
                        const std::vector<SampledTrajectory>& trajectories);

@@ -26,7 +26,7 @@ nlohmann::json run_manifest(const Scene& scene, const BuiltModel& model, const T
   const CostStatistics cost = cost_statistics(profile);
   m["timings"] = {{"steps", cost.steps},          {"step_total_s", cost.total}, {"step_median_s", cost.median},
                   {"step_p99_s", cost.p99},       {"step_max_s", cost.max},     {"rate_allowed_hz", cost.rate_allowed()},
-                  {"wall_s", wall_seconds}};
+                  {"steps_over_budget", profile.steps_over_budget}, {"wall_s", wall_seconds}};
   std::map<std::string, std::size_t> modes;
   std::map<std::string, std::size_t> rows_per_tool;
   std::map<std::string, double> crack;

@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json_fwd.hpp>
 
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -27,6 +28,10 @@ struct ProfileRow {
 
 struct ForceProfile {
   std::vector<ProfileRow> rows;
+  /// Model steps that reported themselves over budget (ForceSample::over_budget on any tool: an
+  /// implicit spring step that did not converge in its iterations, a voxel grid left
+  /// incomplete), counted by run_model. Not a CSV column: a run's manifest holds it.
+  std::size_t steps_over_budget = 0;
 };
 
 /// The CSV header, exactly.

@@ -488,11 +488,22 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
       m_g[k] = g;
       slope += m_r[m_free_dof[static_cast<std::size_t>(k)]] * g;
     }
-    const bool mixed = anderson_mix(anderson);
+    bool mixed = anderson_mix(anderson);
     double mixed_slope = slope;
     if (mixed) {
       mixed_slope = 0.0;
       for (int k = 0; k < m; ++k) mixed_slope += m_r[m_free_dof[static_cast<std::size_t>(k)]] * (m_u_next[k] - m_u[k]);
+      // Mixing is a least-squares fit of the last steps, not a descent method: its step may climb
+      // the potential (r · Δu ≥ 0) while it happens to lower the residual's max-norm, and a run of
+      // such steps can stall the iteration (the blade held still at a cut's bottom did). Such a
+      // step is replaced by the plain kept-factor step g, a descent direction (r · g = −r Q⁻¹ r
+      // < 0 for a positive definite Q), and the mixing's history restarts.
+      if (mixed_slope >= 0.0) {
+        m_u_next.head(m) = m_u.head(m) + m_g.head(m);
+        mixed = false;
+        mixed_slope = slope;
+        anderson = AndersonState{};
+      }
     }
     const double potential = m_potential;
     // Accepted: a lower residual, or (from a double-precision potential) Armijo's decrease of
