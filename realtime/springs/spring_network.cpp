@@ -4,6 +4,7 @@
 #include <Eigen/LU>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -95,21 +96,20 @@ SpringNetwork build_spring_network(const NetworkBlock& block, const std::vector<
   net.constraint.assign(static_cast<std::size_t>(capacity), 0);
   const std::size_t springs = 28 * static_cast<std::size_t>(net.cell_count());
   for (std::vector<int>* v : {&net.springs.a, &net.springs.b}) v->assign(springs, 0);
-  for (std::vector<double>* v : {&net.springs.k, &net.springs.rest, &net.springs.key_k}) v->assign(springs, 0.0);
+  for (std::vector<double>* v : {&net.springs.k, &net.springs.rest}) v->assign(springs, 0.0);
   net.springs.key.assign(springs, 0);
+  net.springs.key_merged.assign(springs, 0);
   merge_springs(net);
   return net;
 }
 
-void merge_springs(SpringNetwork& net) noexcept {
+namespace {
+
+/// The spring arrays from the cells' sorted keys: equal keys merged with summed constants.
+void springs_from_sorted_keys(SpringNetwork& net) noexcept {
   SpringArrays& s = net.springs;
   // The constant travels with the key (its kind's): no cell index is needed beside it.
   const std::size_t n = 28 * static_cast<std::size_t>(net.cell_count());
-  std::size_t m = 0;
-  for (const auto& nodes : net.cell_nodes)
-    for (const CellSpring& cs : cell_springs)
-      s.key[m++] = spring_key(nodes[static_cast<std::size_t>(cs.a)], nodes[static_cast<std::size_t>(cs.b)], cs.type);
-  std::sort(s.key.begin(), s.key.begin() + static_cast<std::ptrdiff_t>(n));
   int count = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint64_t key = s.key[i];
@@ -126,6 +126,60 @@ void merge_springs(SpringNetwork& net) noexcept {
   }
   s.count = count;
   ++net.topology;
+  s.key_topology = net.topology;
+}
+
+} // namespace
+
+void merge_springs(SpringNetwork& net) noexcept {
+  SpringArrays& s = net.springs;
+  const std::size_t n = 28 * static_cast<std::size_t>(net.cell_count());
+  std::size_t m = 0;
+  for (const auto& nodes : net.cell_nodes)
+    for (const CellSpring& cs : cell_springs)
+      s.key[m++] = spring_key(nodes[static_cast<std::size_t>(cs.a)], nodes[static_cast<std::size_t>(cs.b)], cs.type);
+  std::sort(s.key.begin(), s.key.begin() + static_cast<std::ptrdiff_t>(n));
+  springs_from_sorted_keys(net);
+}
+
+void merge_springs_after_split(SpringNetwork& net, int original, int copy) noexcept {
+  SpringArrays& s = net.springs;
+  const std::size_t n = 28 * static_cast<std::size_t>(net.cell_count());
+  if (s.key_topology != net.topology || s.key_merged.size() < n) return merge_springs(net);
+  // The keys the split changes: each moved cell's 7 springs at the copy's corner, before (at
+  // the original) and after. A vertex is a corner of at most 8 cells.
+  constexpr int most = 8 * 7;
+  std::array<std::uint64_t, most> removed{}, added{};
+  int changes = 0;
+  for (const auto& nodes : net.cell_nodes)
+    for (const CellSpring& cs : cell_springs) {
+      const int p = nodes[static_cast<std::size_t>(cs.a)], q = nodes[static_cast<std::size_t>(cs.b)];
+      if (p != copy && q != copy) continue;
+      if (changes == most) return merge_springs(net);
+      removed[static_cast<std::size_t>(changes)] = spring_key(p == copy ? original : p, q == copy ? original : q, cs.type);
+      added[static_cast<std::size_t>(changes)] = spring_key(p, q, cs.type);
+      ++changes;
+    }
+  std::sort(removed.begin(), removed.begin() + changes);
+  std::sort(added.begin(), added.begin() + changes);
+  // One pass over the kept keys: the removed ones left out (each once: a multiset difference),
+  // the added ones merged in.
+  std::size_t m = 0;
+  int r = 0, a = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t key = s.key[i];
+    if (r < changes && removed[static_cast<std::size_t>(r)] == key) {
+      ++r;
+      continue;
+    }
+    if (r < changes && removed[static_cast<std::size_t>(r)] < key) return merge_springs(net); // not among the kept keys
+    while (a < changes && added[static_cast<std::size_t>(a)] <= key) s.key_merged[m++] = added[static_cast<std::size_t>(a++)];
+    s.key_merged[m++] = key;
+  }
+  if (r < changes) return merge_springs(net);
+  while (a < changes) s.key_merged[m++] = added[static_cast<std::size_t>(a++)];
+  std::swap(s.key, s.key_merged);
+  springs_from_sorted_keys(net);
 }
 
 Eigen::Matrix3d cell_deformation_gradient(const Eigen::Matrix<double, 3, 8>& corners, double h) {

@@ -218,7 +218,7 @@ bool VertexTearing::tear(SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3
   net.mass[static_cast<std::size_t>(copy)] = moved * net.cell_mass / 8.0;
   net.mass[static_cast<std::size_t>(worst)] = (total_cells - moved) * net.cell_mass / 8.0;
   m_opened[static_cast<std::size_t>(worst)] = m_opened[static_cast<std::size_t>(copy)] = 1;
-  merge_springs(net);
+  merge_springs_after_split(net, worst, copy);
   share_springs_after_split(net, copy);
   return true;
 }

@@ -7,6 +7,7 @@
 #include "realtime/springs/torn_tet_mesh.hpp"
 #include "realtime/springs/vertex_tearing.hpp"
 #include "tests/realtime/springs/model_fixtures.hpp"
+#include "tests/realtime/springs/network_fixtures.hpp"
 
 #include <gtest/gtest.h>
 
@@ -150,6 +151,72 @@ TEST(Tearing, VertexStressesAreTheSumsOfTheCellStressesOnATornNetwork) {
         ASSERT_EQ(tearing.cell_stress_sum(p).data()[e], expected[static_cast<std::size_t>(p)].data()[e]) << "call " << call << ", node " << p;
   }
   EXPECT_GE(splits, 3) << "largest vertex stress " << tearing.last_max_stress() << " Pa"; // the sharing was updated after splits, not only built
+}
+
+/// Splits node `original` the way a tear does: the cells whose centre lies on the positive side
+/// of `normal` through it take a new copy. Returns the copy, or -1 if one side holds no cell.
+int split_by_hand(SpringNetwork& net, int original, const Eigen::Vector3d& normal) {
+  const int copy = net.node_count;
+  int moved = 0, staying = 0;
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const Eigen::Vector3d centre = net.block.origin + (net.cell_index[static_cast<std::size_t>(c)].cast<double>() + Eigen::Vector3d::Constant(0.5)) * net.block.cell_size;
+    for (int& id : net.cell_nodes[static_cast<std::size_t>(c)])
+      if (id == original) ((centre - net.rest.col(original)).dot(normal) > 0.0 ? moved : staying) += 1;
+  }
+  if (moved == 0 || staying == 0) return -1;
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const Eigen::Vector3d centre = net.block.origin + (net.cell_index[static_cast<std::size_t>(c)].cast<double>() + Eigen::Vector3d::Constant(0.5)) * net.block.cell_size;
+    for (int& id : net.cell_nodes[static_cast<std::size_t>(c)])
+      if (id == original && (centre - net.rest.col(original)).dot(normal) > 0.0) id = copy;
+  }
+  net.rest.col(copy) = net.rest.col(original);
+  ++net.node_count;
+  return copy;
+}
+
+void expect_equal_springs(const SpringNetwork& a, const SpringNetwork& b, const std::string& where) {
+  ASSERT_EQ(a.springs.count, b.springs.count) << where;
+  for (int i = 0; i < a.springs.count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    ASSERT_EQ(a.springs.a[k], b.springs.a[k]) << where << ", spring " << i;
+    ASSERT_EQ(a.springs.b[k], b.springs.b[k]) << where << ", spring " << i;
+    ASSERT_EQ(a.springs.k[k], b.springs.k[k]) << where << ", spring " << i; // bit-identical sums
+    ASSERT_EQ(a.springs.rest[k], b.springs.rest[k]) << where << ", spring " << i;
+  }
+}
+
+// The second method is merge_springs itself: the springs rebuilt from every cell after each
+// split, which merge_springs_after_split must give to the bit (the same order, the same sums).
+TEST(MergeSpringsAfterSplit, GivesWhatAFullMergeGivesAfterEverySplit) {
+  const double h = 2.5e-3;
+  SpringNetwork incremental = test::full_block(4, h, identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness);
+  SpringNetwork full = incremental;
+  // Interior, face, edge and corner nodes split along the three axes and a diagonal, some of
+  // them twice (a copy's own cells split again), so that edges shared by 1-4 cells change.
+  const Eigen::Vector3d normals[] = {Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),
+                                     Eigen::Vector3d(1.0, 1.0, 0.5)};
+  int splits = 0;
+  for (int round = 0; round < 3; ++round)
+    for (int p = 0; p < incremental.node_count && splits < 60; p += 7) {
+      const Eigen::Vector3d& normal = normals[static_cast<std::size_t>((p + round) % 4)];
+      const int copy = split_by_hand(incremental, p, normal);
+      if (copy < 0) continue;
+      ASSERT_EQ(split_by_hand(full, p, normal), copy);
+      merge_springs_after_split(incremental, p, copy);
+      merge_springs(full);
+      expect_equal_springs(incremental, full, "split " + std::to_string(splits) + " of node " + std::to_string(p));
+      ++splits;
+    }
+  EXPECT_GE(splits, 30);
+  // Keys that are not among the kept ones (here: the split named with a wrong original): the
+  // whole network is merged again, with the same result.
+  int copy = -1, p = 0;
+  for (; p < incremental.node_count && copy < 0; ++p) copy = split_by_hand(incremental, p, normals[0]);
+  ASSERT_GE(copy, 0);
+  ASSERT_EQ(split_by_hand(full, p - 1, normals[0]), copy);
+  merge_springs_after_split(incremental, copy - 1, copy);
+  merge_springs(full);
+  expect_equal_springs(incremental, full, "a split named with a wrong original");
 }
 
 } // namespace
