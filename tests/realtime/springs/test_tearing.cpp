@@ -157,18 +157,19 @@ TEST(Tearing, VertexStressesAreTheSumsOfTheCellStressesOnATornNetwork) {
 /// of `normal` through it take a new copy. Returns the copy, or -1 if one side holds no cell.
 int split_by_hand(SpringNetwork& net, int original, const Eigen::Vector3d& normal) {
   const int copy = net.node_count;
+  const auto moves = [&](int c) {
+    const Eigen::Vector3d centre =
+        net.block.origin + (net.cell_index[static_cast<std::size_t>(c)].cast<double>() + Eigen::Vector3d::Constant(0.5)) * net.block.cell_size;
+    return (centre - net.rest.col(original)).dot(normal) > 0.0;
+  };
   int moved = 0, staying = 0;
-  for (int c = 0; c < net.cell_count(); ++c) {
-    const Eigen::Vector3d centre = net.block.origin + (net.cell_index[static_cast<std::size_t>(c)].cast<double>() + Eigen::Vector3d::Constant(0.5)) * net.block.cell_size;
-    for (int& id : net.cell_nodes[static_cast<std::size_t>(c)])
-      if (id == original) ((centre - net.rest.col(original)).dot(normal) > 0.0 ? moved : staying) += 1;
-  }
+  for (int c = 0; c < net.cell_count(); ++c)
+    for (const int id : net.cell_nodes[static_cast<std::size_t>(c)])
+      if (id == original) (moves(c) ? moved : staying) += 1;
   if (moved == 0 || staying == 0) return -1;
-  for (int c = 0; c < net.cell_count(); ++c) {
-    const Eigen::Vector3d centre = net.block.origin + (net.cell_index[static_cast<std::size_t>(c)].cast<double>() + Eigen::Vector3d::Constant(0.5)) * net.block.cell_size;
+  for (int c = 0; c < net.cell_count(); ++c)
     for (int& id : net.cell_nodes[static_cast<std::size_t>(c)])
-      if (id == original && (centre - net.rest.col(original)).dot(normal) > 0.0) id = copy;
-  }
+      if (id == original && moves(c)) id = copy;
   net.rest.col(copy) = net.rest.col(original);
   ++net.node_count;
   return copy;
