@@ -99,6 +99,41 @@ void force_cost(benchmark::State& state, bool lattice) {
   state.counters["springs"] = net.springs.count;
 }
 
+/// force_cost after a tear: the full N^3 block cracked through at x = h floor(N/2) (every node of
+/// that plane split, the cells on the +x side moved to the copies, N^2 of them), evaluated by
+/// the lattice built before the tear (its cells at copies as exceptions) or over the merged
+/// flat arrays (network_forces, what the torn network used before).
+void torn_force_cost(benchmark::State& state, bool lattice) {
+  const int n = static_cast<int>(state.range(0));
+  const double h = 2.5e-3;
+  NetworkBlock block;
+  block.cell_size = h;
+  block.cells = Eigen::Vector3i::Constant(n);
+  SpringNetwork net = build_spring_network(block, std::vector<bool>(static_cast<std::size_t>(n * n * n), true),
+                                           identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0, 2e-5);
+  LatticeForces forces(net);
+  const int plane = n / 2;
+  const int nodes = net.node_count;
+  for (int p = 0; p < nodes && net.node_count < net.node_capacity(); ++p) {
+    if (std::abs(net.rest(0, p) - h * plane) > 1e-3 * h) continue;
+    const int copy = net.node_count++;
+    net.rest.col(copy) = net.rest.col(p);
+    net.mass[static_cast<std::size_t>(copy)] = net.mass[static_cast<std::size_t>(p)];
+    for (int c = 0; c < net.cell_count(); ++c)
+      if (net.cell_index[static_cast<std::size_t>(c)].x() == plane)
+        for (int& id : net.cell_nodes[static_cast<std::size_t>(c)]) id = id == p ? copy : id;
+  }
+  merge_springs(net);
+  Eigen::Matrix3Xd x = net.rest, v = Eigen::Matrix3Xd::Zero(3, net.node_capacity()), f(3, net.node_capacity());
+  for (int q = 0; q < net.node_count; ++q) x(2, q) += 1e-4 * std::sin(x(0, q) * 400.0), v(1, q) = 1e-3 * std::cos(x(2, q) * 300.0);
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(lattice ? forces.evaluate(net, x, v, f) : network_forces(net, x, v, f));
+    benchmark::DoNotOptimize(f.data());
+  }
+  state.counters["exceptions"] = forces.exception_count();
+  state.counters["copies"] = net.node_count - nodes;
+}
+
 /// A full N^3 clay block (2.5 mm cells, damped) with its base (z = 0) fixed: the implicit step's
 /// system without the stylus.
 SpringNetwork clay_block(int n) {
@@ -310,6 +345,8 @@ BENCHMARK_CAPTURE(step_cost, implicit_peer, SpringIntegrator::implicit_euler, pe
 BENCHMARK_CAPTURE(step_cost, linear_implicit_peer, SpringIntegrator::linearly_implicit_euler, peer)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(force_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(torn_force_cost, springs_loop, false)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(torn_force_cost, lattice, true)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(system_cost, solve, false, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(system_cost, solve_double, false, NetworkSystem::SolvePrecision::double_precision)->Arg(8)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(system_cost, factorize, true, NetworkSystem::SolvePrecision::single_precision)->DenseRange(4, 16, 4)->Unit(benchmark::kMicrosecond);

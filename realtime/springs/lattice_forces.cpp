@@ -462,8 +462,14 @@ float volume_forces(int P, int pad, const int* corner, float c, float kappa_v0, 
 } // namespace
 
 LatticeForces::LatticeForces(const SpringNetwork& net) {
-  const Eigen::Vector3i n = net.block.cells;
-  const int px = n.x() + 1, py = n.y() + 1, pz = n.z() + 1;
+  // The lattice spans the box of the block's cells that are kept (a network's block is a cube
+  // around the body; its pruned cells have no springs, so lattice points beyond the kept cells'
+  // box would only add springs of zero constant to every loop): cells lo .. hi − 1.
+  if (net.cell_count() == 0) return;
+  Eigen::Vector3i lo = net.cell_index.front(), hi = net.cell_index.front();
+  for (const Eigen::Vector3i& g : net.cell_index) lo = lo.cwiseMin(g), hi = hi.cwiseMax(g);
+  hi += Eigen::Vector3i::Ones();
+  const int px = hi.x() - lo.x() + 1, py = hi.y() - lo.y() + 1, pz = hi.z() - lo.z() + 1;
   m_points = px * py * pz;
   const auto linear = [px, py](int i, int j, int k) { return i + px * (j + py * k); };
   for (std::size_t d = 0; d < directions.size(); ++d) {
@@ -480,35 +486,40 @@ LatticeForces::LatticeForces(const SpringNetwork& net) {
   m_slot.assign(static_cast<std::size_t>(net.node_capacity()), -1);
   std::vector<int> node_at(static_cast<std::size_t>(m_points), -1);
   for (int p = 0; p < net.node_count; ++p) {
-    const Eigen::Vector3i g = ((net.rest.col(p) - net.block.origin) / h).array().round().cast<int>();
+    const Eigen::Vector3i g = ((net.rest.col(p) - net.block.origin) / h).array().round().cast<int>() - lo.array();
     if ((g.array() < 0).any() || g.x() >= px || g.y() >= py || g.z() >= pz) return;
     const int s = linear(g.x(), g.y(), g.z());
     if (node_at[static_cast<std::size_t>(s)] >= 0) return;
     node_at[static_cast<std::size_t>(s)] = p;
     m_slot[static_cast<std::size_t>(p)] = s;
   }
+  // Each cell spring, from corner a to corner b, as a lattice direction from one of its ends.
+  for (std::size_t i = 0; i < cell_springs.size(); ++i) {
+    const CellSpring& s = cell_springs[i];
+    std::array<int, 3> e{((s.b & 1) - (s.a & 1)), ((s.b >> 1) & 1) - ((s.a >> 1) & 1), ((s.b >> 2) & 1) - ((s.a >> 2) & 1)};
+    int start = s.a;
+    const int first = e[0] != 0 ? e[0] : e[1] != 0 ? e[1] : e[2];
+    if (first < 0) {
+      for (int& component : e) component = -component;
+      start = s.b;
+    }
+    m_spring_direction[i] = static_cast<int>(std::find(directions.begin(), directions.end(), e) - directions.begin());
+    m_spring_start[i] = start;
+  }
+  m_cell_point.resize(static_cast<std::size_t>(net.cell_count()));
+  for (int c = 0; c < net.cell_count(); ++c) {
+    const Eigen::Vector3i g = net.cell_index[static_cast<std::size_t>(c)] - lo;
+    m_cell_point[static_cast<std::size_t>(c)] = linear(g.x(), g.y(), g.z());
+  }
   m_k.assign(13 * static_cast<std::size_t>(m_points), 0.0);
   m_cell.assign(static_cast<std::size_t>(m_points), 0.0);
+  m_node_count = net.node_count; // (for on_lattice below)
   for (int c = 0; c < net.cell_count(); ++c) {
-    const Eigen::Vector3i& g = net.cell_index[static_cast<std::size_t>(c)];
-    const int base = linear(g.x(), g.y(), g.z());
-    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(c)];
-    for (int a = 0; a < 8; ++a)
-      if (m_slot[static_cast<std::size_t>(nodes[static_cast<std::size_t>(a)])] != base + m_corner[static_cast<std::size_t>(a)]) return;
-    m_cell[static_cast<std::size_t>(base)] = 1.0;
-    for (const CellSpring& s : cell_springs) {
-      // The spring from corner a to corner b as a lattice direction from one of its ends.
-      std::array<int, 3> e{((s.b & 1) - (s.a & 1)), ((s.b >> 1) & 1) - ((s.a >> 1) & 1), ((s.b >> 2) & 1) - ((s.a >> 2) & 1)};
-      int start = s.a;
-      const int first = e[0] != 0 ? e[0] : e[1] != 0 ? e[1] : e[2];
-      if (first < 0) {
-        for (int& component : e) component = -component;
-        start = s.b;
-      }
-      const auto d = static_cast<std::size_t>(std::find(directions.begin(), directions.end(), e) - directions.begin());
-      m_k[d * static_cast<std::size_t>(m_points) + static_cast<std::size_t>(base + m_corner[static_cast<std::size_t>(start)])] +=
-          net.spring_constant(s.type);
+    if (!on_lattice(net, c)) {
+      m_node_count = -1;
+      return;
     }
+    add_to_lattice(net, c, m_k, m_cell);
   }
   m_x.assign(3 * static_cast<std::size_t>(m_points), 0.0);
   m_v.assign(3 * static_cast<std::size_t>(m_points), 0.0);
@@ -546,13 +557,53 @@ LatticeForces::LatticeForces(const SpringNetwork& net) {
       for (int i = 0; i < px; ++i)
         for (int r = 0; r < 3; ++r)
           m_x[static_cast<std::size_t>(r * m_points + linear(i, j, k))] = m_rest[static_cast<std::size_t>(r * m_points + linear(i, j, k))] =
-              net.block.origin[r] + h * Eigen::Vector3i(i, j, k)[r];
-  m_node_count = net.node_count;
+              net.block.origin[r] + h * (lo + Eigen::Vector3i(i, j, k))[r];
+  m_k_torn.assign(m_k.size(), 0.0);
+  m_cell_torn.assign(m_cell.size(), 0.0);
+  m_exceptions.reserve(static_cast<std::size_t>(net.cell_count()));
+  m_cell_count = net.cell_count();
   m_topology = net.topology;
+}
+
+bool LatticeForces::on_lattice(const SpringNetwork& net, int cell) const noexcept {
+  const int base = m_cell_point[static_cast<std::size_t>(cell)];
+  const auto& nodes = net.cell_nodes[static_cast<std::size_t>(cell)];
+  for (int a = 0; a < 8; ++a) {
+    const int node = nodes[static_cast<std::size_t>(a)];
+    if (node >= m_node_count || m_slot[static_cast<std::size_t>(node)] != base + m_corner[static_cast<std::size_t>(a)]) return false;
+  }
+  return true;
+}
+
+void LatticeForces::add_to_lattice(const SpringNetwork& net, int cell, std::vector<double>& k, std::vector<double>& mask) const noexcept {
+  const int base = m_cell_point[static_cast<std::size_t>(cell)];
+  mask[static_cast<std::size_t>(base)] = 1.0;
+  for (std::size_t i = 0; i < cell_springs.size(); ++i)
+    k[static_cast<std::size_t>(m_spring_direction[i]) * static_cast<std::size_t>(m_points) +
+      static_cast<std::size_t>(base + m_corner[static_cast<std::size_t>(m_spring_start[i])])] += net.spring_constant(cell_springs[i].type);
+}
+
+void LatticeForces::find_exceptions(const SpringNetwork& net) noexcept {
+  std::fill(m_k_torn.begin(), m_k_torn.end(), 0.0);
+  std::fill(m_cell_torn.begin(), m_cell_torn.end(), 0.0);
+  m_exceptions.clear();
+  for (int c = 0; c < net.cell_count(); ++c) {
+    if (on_lattice(net, c))
+      add_to_lattice(net, c, m_k_torn, m_cell_torn);
+    else
+      m_exceptions.push_back(c); // within the capacity reserved at construction
+  }
+  m_torn_topology = net.topology;
+  m_torn_found = true;
 }
 
 bool LatticeForces::applies(const SpringNetwork& net) const noexcept {
   return m_node_count >= 0 && net.node_count == m_node_count && net.topology == m_topology;
+}
+
+bool LatticeForces::applies_torn(const SpringNetwork& net) const noexcept {
+  return m_node_count >= 0 && net.node_count >= m_node_count && net.cell_count() == m_cell_count &&
+         net.node_capacity() == static_cast<int>(m_slot.size());
 }
 
 void LatticeForces::gather(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v) noexcept {
@@ -620,7 +671,7 @@ double LatticeForces::substep(const SpringNetwork& net, double h, ForcePrecision
 
 double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                                Eigen::Matrix3Xd& f, ForcePrecision precision) noexcept {
-  if (!applies(net)) return network_forces(net, x, v, f);
+  if (!applies(net)) return applies_torn(net) ? evaluate_torn(net, x, v, f) : network_forces(net, x, v, f);
   const bool single = precision == ForcePrecision::single_precision;
   if (single)
     gather_single(x, v);
@@ -632,6 +683,36 @@ double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd&
     const int s = m_slot[static_cast<std::size_t>(p)];
     for (int r = 0; r < 3; ++r)
       f(r, p) = single ? static_cast<double>(m_f_single[static_cast<std::size_t>(r * P + s)]) : m_f[static_cast<std::size_t>(r * P + s)];
+  }
+  return energy;
+}
+
+double LatticeForces::evaluate_torn(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
+                                    Eigen::Matrix3Xd& f) noexcept {
+  if (!m_torn_found || net.topology != m_torn_topology) find_exceptions(net);
+  // The lattice's own nodes (the first m_node_count: a split appends its copy) on the lattice,
+  // with the constants and cells of the cells still there; a point whose node lost all its
+  // cells to copies keeps its springs' zero constants.
+  gather_double(x, v);
+  double energy = lattice_forces_in<double>(net, true);
+  const int P = m_points;
+  for (int p = 0; p < m_node_count; ++p) {
+    const int s = m_slot[static_cast<std::size_t>(p)];
+    for (int r = 0; r < 3; ++r) f(r, p) = m_f[static_cast<std::size_t>(r * P + s)];
+  }
+  f.middleCols(m_node_count, net.node_count - m_node_count).setZero();
+  // The exceptions: each cell's 28 springs and volume term on its own corners (cell_forces, the
+  // same law; a spring it shares with a cell on the lattice is the sum of the two cells' shares,
+  // as in the merged arrays).
+  Eigen::Matrix<double, 3, 8> xc, vc, fc;
+  for (const int c : m_exceptions) {
+    const auto& nodes = net.cell_nodes[static_cast<std::size_t>(c)];
+    for (int a = 0; a < 8; ++a) {
+      xc.col(a) = x.col(nodes[static_cast<std::size_t>(a)]);
+      vc.col(a) = v.col(nodes[static_cast<std::size_t>(a)]);
+    }
+    energy += cell_forces(net, c, xc, vc, fc);
+    for (int a = 0; a < 8; ++a) f.col(nodes[static_cast<std::size_t>(a)]) += fc.col(a);
   }
   return energy;
 }
@@ -674,7 +755,7 @@ double LatticeForces::gershgorin_bound(const SpringNetwork& net, const Eigen::Ma
 }
 
 template <class Real>
-double LatticeForces::lattice_forces_in(const SpringNetwork& net) noexcept {
+double LatticeForces::lattice_forces_in(const SpringNetwork& net, bool torn) noexcept {
   constexpr bool single = std::is_same_v<Real, float>;
   // The state each precision reads (double: positions; single: displacements from the rest
   // lattice) and the planes it writes.
@@ -688,7 +769,7 @@ double LatticeForces::lattice_forces_in(const SpringNetwork& net) noexcept {
     F = m_f_single.data(), G = m_g_single.data(), Q = m_q_single.data();
     std::fill(m_f_single.begin(), m_f_single.end(), 0.0f);
   } else {
-    X = m_x.data(), V = m_v.data(), K = m_k.data(), cell = m_cell.data();
+    X = m_x.data(), V = m_v.data(), K = torn ? m_k_torn.data() : m_k.data(), cell = torn ? m_cell_torn.data() : m_cell.data();
     F = m_f.data(), G = m_g.data(), Q = m_q.data();
     std::fill(m_f.begin(), m_f.end(), 0.0);
   }

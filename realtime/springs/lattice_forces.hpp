@@ -1,6 +1,6 @@
 #pragma once
 // LatticeForces: the spring network's internal forces (the same as network_forces) computed on
-// the regular lattice of the block while no vertex has been split: every spring of the block is
+// the regular lattice of the block (the box of its kept cells): every spring of the block is
 // one of 13 lattice directions from a lattice point, and every cell one lattice point (its lower
 // corner), so the force loops run over contiguous, unit-stride arrays and vectorise (SIMD lanes
 // = neighbouring lattice points) instead of gathering and scattering per spring.
@@ -18,7 +18,11 @@ namespace kerf {
 /// Network forces on the block's lattice (paper 000 §2.1's cubic cells, springs as in
 /// network_forces). Built for one network (allocates); `evaluate` uses the lattice while the
 /// network still has the cells, corners and constants it was built with (its `topology` count
-/// unchanged, i.e. no tear since) and falls back to network_forces afterwards. Allocation-free.
+/// unchanged, i.e. no tear since). After tears (vertex splits, §2.2: some cells' corners
+/// re-pointed to copies appended after the network's nodes) it evaluates the torn network as
+/// the lattice with exceptions: the cells whose corners are all still the lattice's own nodes
+/// stay on the lattice, and the others (the cells at a split vertex's copy) are evaluated one by
+/// one with cell_forces on their own corners. Allocation-free.
 class LatticeForces {
 public:
   LatticeForces() = default;
@@ -28,14 +32,21 @@ public:
 
   /// True if `net` is still the network this was built for (no vertex split since).
   [[nodiscard]] bool applies(const SpringNetwork& net) const noexcept;
+  /// True if `net` is the network this was built for, torn since or not: its first nodes are
+  /// the lattice's, its cells the same cells (copies of split vertices come after).
+  [[nodiscard]] bool applies_torn(const SpringNetwork& net) const noexcept;
+  /// Cells of `net` evaluated off the lattice (those with a corner not the lattice's own node)
+  /// at the last torn evaluation; 0 while untorn.
+  [[nodiscard]] int exception_count() const noexcept { return static_cast<int>(m_exceptions.size()); }
 
   /// f (3 x capacity, overwritten for the nodes in use) = the internal forces at positions x and
   /// velocities v, exactly the sum network_forces computes (to round-off):
   ///   spring:  f_a = k (l − L) d + τ k ((v_b − v_a)·d) d,  d = (x_b − x_a)/l   (and −that on b);
   ///   volume:  f_a = −κ V₀ ((J − 1) + τ J̇) cof(F) g_a.
   /// Returns the elastic energy Σ ½ k (l − L)² + Σ ½ κ V₀ (J − 1)² [J]. With
-  /// ForcePrecision::single_precision the loops run in single precision (see `substep`; after a
-  /// split the fallback is double).
+  /// ForcePrecision::single_precision the loops run in single precision (see `substep`); a torn
+  /// network is evaluated in double precision whatever is asked: on the lattice with exceptions
+  /// while `applies_torn`, else by network_forces.
   enum class ForcePrecision { double_precision, single_precision };
   double evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& f,
                   ForcePrecision precision = ForcePrecision::double_precision) noexcept;
@@ -91,14 +102,25 @@ private:
   /// volume kernels are each precision's own (the float ones on displacements, without
   /// cancellation).
   template <class Real>
-  double lattice_forces_in(const SpringNetwork& net) noexcept;
+  double lattice_forces_in(const SpringNetwork& net, bool torn = false) noexcept;
+  /// `evaluate` on a torn network (`applies_torn`): the lattice with the torn constants and cell
+  /// mask for the cells still on it, then cell_forces for each exception, added at its corners.
+  double evaluate_torn(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v, Eigen::Matrix3Xd& f) noexcept;
+  /// The torn constants, cell mask and exception cells for `net`'s present corners (after each
+  /// change of its topology). Allocation-free.
+  void find_exceptions(const SpringNetwork& net) noexcept;
+  /// True if every corner of `cell` is the lattice's own node at that corner's point.
+  [[nodiscard]] bool on_lattice(const SpringNetwork& net, int cell) const noexcept;
+  /// Adds `cell`'s 28 spring constants to k (13 x points) and marks it in mask (points).
+  void add_to_lattice(const SpringNetwork& net, int cell, std::vector<double>& k, std::vector<double>& mask) const noexcept;
   double lattice_forces(const SpringNetwork& net) noexcept;
   /// The same in single precision, from the single-precision copies into m_f_single.
   double lattice_forces_single(const SpringNetwork& net) noexcept;
 
   std::uint64_t m_topology = 0;
   int m_node_count = -1;
-  int m_points = 0;                    ///< lattice points (Nx+1)(Ny+1)(Nz+1)
+  int m_cell_count = 0;
+  int m_points = 0;                    ///< lattice points of the kept cells' box, (nx+1)(ny+1)(nz+1)
   int m_pad = 0;                       ///< leading zero entries of the cell arrays (the corner-7 offset)
   std::array<int, 13> m_offset{};      ///< linear offset of each direction
   std::array<int, 13> m_type{};        ///< 1 edge, 2 face diagonal, 3 body diagonal
@@ -114,6 +136,16 @@ private:
   std::vector<double> m_bound_weight;  ///< points: 1/m of a node not fixed on all axes, else 0 [1/kg]
   std::vector<double> m_row;           ///< points: Gershgorin row sums [N/m]
   std::vector<double> m_rest;          ///< 3 x points: the lattice points' rest positions [m]
+  /// Each cell spring (cell_springs' order) as a lattice direction d and the local corner it
+  /// starts from: its constant sits at m_k[d P + (cell's point + m_corner[start])].
+  std::array<int, 28> m_spring_direction{}, m_spring_start{};
+  std::vector<int> m_cell_point;       ///< per cell: its lattice point (lower corner)
+  /// A torn network (`find_exceptions`): the constants and cell mask of the cells still on the
+  /// lattice, the cells evaluated off it, and the topology these were found for.
+  std::vector<double> m_k_torn, m_cell_torn;
+  std::vector<int> m_exceptions;       ///< capacity: every cell (sized at construction)
+  std::uint64_t m_torn_topology = 0;
+  bool m_torn_found = false;
   /// ForcePrecision::single_precision: u = x − X [m], v, f, one direction's forces, the cells'
   /// corner forces, the spring constants and the cell mask, in single precision.
   std::vector<float> m_u_single, m_v_single, m_f_single, m_g_single, m_q_single, m_k_single, m_cell_single;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -105,6 +106,15 @@ SpringNetwork build_spring_network(const NetworkBlock& block, const std::vector<
 
 namespace {
 
+/// A topology value no network has had before in this process (SpringNetwork::topology): a copy
+/// of a network taken before a tear and torn again differently never shows a value seen with
+/// other corners, so the caches keyed by it (the kept sorted keys, VertexTearing's shared
+/// springs, LatticeForces' exceptions) cannot mistake one network for the other. Lock-free.
+std::uint64_t next_topology() noexcept {
+  static std::atomic<std::uint64_t> counter{0};
+  return counter.fetch_add(1, std::memory_order_relaxed) + 1;
+}
+
 /// The spring arrays from the cells' sorted keys: equal keys merged with summed constants.
 void springs_from_sorted_keys(SpringNetwork& net) noexcept {
   SpringArrays& s = net.springs;
@@ -125,7 +135,7 @@ void springs_from_sorted_keys(SpringNetwork& net) noexcept {
     ++count;
   }
   s.count = count;
-  ++net.topology;
+  net.topology = next_topology();
   s.key_topology = net.topology;
 }
 

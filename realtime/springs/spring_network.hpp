@@ -84,8 +84,10 @@ struct SpringNetwork {
   int node_count = 0;
   SpringArrays springs;                        ///< from cell_nodes by merge_springs
   NodeAnchors anchors;                         ///< a compliant grasp's anchors (none: rigid or no grasp)
-  /// Incremented by every merge_springs: a count that changes whenever the cells' corners may
-  /// have (LatticeForces uses it to know the network is still the one it was built for).
+  /// Set by every merge_springs to a value no network has had before in the process: it changes
+  /// whenever the cells' corners may have, and equal values mean equal corners (LatticeForces
+  /// uses it to know the network is still the one it was built for, and which cells a tear took
+  /// off its lattice).
   std::uint64_t topology = 0;
 
   [[nodiscard]] int cell_count() const { return static_cast<int>(cell_nodes.size()); }

@@ -66,37 +66,80 @@ TEST(LatticeForces, EqualTheCellSum) {
   }
 }
 
-TEST(LatticeForces, FallsBackToTheSpringLoopAfterASplit) {
-  // A split vertex (two nodes on one lattice point) is not a lattice: evaluate then gives
-  // network_forces, still equal to the cell sum.
-  Scattered s = scattered_block(4);
-  LatticeForces lattice(s.net);
-  int shared = -1; // a node of more than one cell
-  std::vector<int> cells(static_cast<std::size_t>(s.net.node_count), 0);
-  for (const auto& nodes : s.net.cell_nodes)
-    for (int id : nodes) ++cells[static_cast<std::size_t>(id)];
-  for (int n = 0; n < s.net.node_count && shared < 0; ++n)
-    if (cells[static_cast<std::size_t>(n)] >= 2) shared = n;
-  ASSERT_GE(shared, 0);
+/// Splits `node` of `s` (paper 000 §2.2's vertex split, by hand): its cells after the first
+/// move to a copy appended to the nodes, placed `offset` from it; the springs merged again.
+/// Returns the cells moved.
+int split_by_hand(Scattered& s, int node, const Eigen::Vector3d& offset) {
   const int copy = s.net.node_count++;
-  s.x.col(copy) = s.x.col(shared) + Eigen::Vector3d(2e-5, 0, 0);
-  s.v.col(copy) = s.v.col(shared);
-  s.net.rest.col(copy) = s.net.rest.col(shared);
+  s.x.col(copy) = s.x.col(node) + offset;
+  s.v.col(copy) = s.v.col(node);
+  s.net.rest.col(copy) = s.net.rest.col(node);
   bool first = true;
-  for (auto& nodes : s.net.cell_nodes)
+  int moved = 0;
+  for (auto& nodes : s.net.cell_nodes) {
+    bool here = false;
     for (int& id : nodes)
-      if (id == shared) {
-        if (!first) id = copy;
+      if (id == node) {
+        if (!first) id = copy, here = true;
         first = false;
       }
+    moved += here ? 1 : 0;
+  }
   merge_springs(s.net);
-  EXPECT_FALSE(lattice.applies(s.net));
-  EXPECT_FALSE(LatticeForces(s.net).applies(s.net)); // nor is one built on the torn network
+  return moved;
+}
+
+/// The nodes of `s` shared by two cells or more, in order.
+std::vector<int> shared_nodes(const Scattered& s) {
+  std::vector<int> cells(static_cast<std::size_t>(s.net.node_count), 0), shared;
+  for (const auto& nodes : s.net.cell_nodes)
+    for (int id : nodes) ++cells[static_cast<std::size_t>(id)];
+  for (int n = 0; n < s.net.node_count; ++n)
+    if (cells[static_cast<std::size_t>(n)] >= 2) shared.push_back(n);
+  return shared;
+}
+
+TEST(LatticeForces, EvaluatesATornNetworkWithItsSplitCellsAsExceptions) {
+  // After vertex splits (two nodes on one lattice point: no lattice of its own, as a network
+  // built torn shows) the lattice built before them evaluates the torn network with the cells at
+  // a copy as exceptions. Reference: the cell-by-cell sum of cell_forces on the torn cells.
+  Scattered s = scattered_block(4);
+  const SpringNetwork untorn = s.net;
+  const Eigen::Matrix3Xd x_untorn = s.x, v_untorn = s.v;
+  LatticeForces lattice(s.net);
+  const std::vector<int> shared = shared_nodes(s);
+  ASSERT_GE(shared.size(), 6u);
   Eigen::Matrix3Xd expected(3, s.net.node_capacity()), f(3, s.net.node_capacity());
-  cell_sum(s.net, s.x, s.v, expected);
-  lattice.evaluate(s.net, s.x, s.v, f);
-  const double scale = expected.leftCols(s.net.node_count).cwiseAbs().maxCoeff();
-  EXPECT_LT((f - expected).leftCols(s.net.node_count).cwiseAbs().maxCoeff(), 1e-12 * scale);
+  const auto agrees = [&](const char* what) {
+    EXPECT_FALSE(lattice.applies(s.net)) << what;
+    EXPECT_TRUE(lattice.applies_torn(s.net)) << what;
+    const double expected_energy = cell_sum(s.net, s.x, s.v, expected);
+    f.setConstant(1e9); // every node's force is written
+    const double energy = lattice.evaluate(s.net, s.x, s.v, f);
+    const double scale = expected.leftCols(s.net.node_count).cwiseAbs().maxCoeff();
+    EXPECT_LT((f - expected).leftCols(s.net.node_count).cwiseAbs().maxCoeff(), 1e-12 * scale) << what;
+    EXPECT_NEAR(energy, expected_energy, 1e-12 * expected_energy) << what;
+  };
+  const int moved = split_by_hand(s, shared[0], {2e-5, 0, 0});
+  EXPECT_FALSE(LatticeForces(s.net).applies(s.net)); // a lattice built on the torn network is none
+  agrees("one split");
+  EXPECT_EQ(lattice.exception_count(), moved);
+  // The network as it was before the tear, torn once elsewhere: the exceptions found for the
+  // first tear are not kept (each merge gives a topology no network had before; a count
+  // incremented per merge would repeat the first tear's here).
+  s.net = untorn;
+  s.x = x_untorn;
+  s.v = v_untorn;
+  Eigen::Matrix3Xd untorn_f(3, s.net.node_capacity());
+  lattice.evaluate(s.net, s.x, s.v, untorn_f);
+  const int moved_elsewhere = split_by_hand(s, shared[3], {0, 0, 5e-5});
+  agrees("the untorn network torn elsewhere");
+  EXPECT_EQ(lattice.exception_count(), moved_elsewhere);
+  // More splits, one of them of a copy (the copy's cells split again), the copy far off.
+  for (const int node : {shared[2], shared[5], s.net.node_count - 1}) {
+    split_by_hand(s, node, {-3e-5, 4e-5, 1e-5});
+    agrees("further splits");
+  }
 }
 
 /// The scattered block with its lowest layer of nodes fixed and one node fixed along x only.
