@@ -43,7 +43,13 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   for (auto& s : m_systems) s->rebuild(net, tear_ready ? split_room() : NetworkSystem::SplitRoom::none);
   m_active = 0;
   if (m_refresh) m_refresh->reserve(net);
-  m_correction.reserve(active().dof_count());
+  for (FactorState* f : {&m_kept, &m_fresh}) {
+    f->correction.reserve(active().dof_count());
+    f->x.setZero(3, net.node_capacity());
+    f->dt = -1.0;
+    f->uncorrected = false;
+  }
+  m_taking_up = false;
   m_forces = LatticeForces(net);
   const int cap = net.node_capacity();
   m_x0.setZero(3, cap);
@@ -51,7 +57,6 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_f.setZero(3, cap);
   m_zero.setZero(3, cap);
   m_x_before.setZero(3, cap);
-  m_x_factor.setZero(3, cap);
   m_free_entry.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_dof.assign(3 * static_cast<std::size_t>(cap), 0);
   m_free_mass.assign(3 * static_cast<std::size_t>(cap), 0.0);
@@ -62,7 +67,6 @@ void NewtonStepper::rebuild(const SpringNetwork& net) {
   m_du.setZero(3 * cap, std::max(m_policy.anderson_depth, 1));
   m_dg.setZero(3 * cap, std::max(m_policy.anderson_depth, 1));
   bind_free_entries(net);
-  m_factor_dt = -1.0;
   m_splits = 0;
   // Quasi-static regulariser: 1e-8 of the stiffness-to-mass scale k₁ / (cell mass / 8).
   m_static_regularisation = 1e-8 * net.stiffness.edge / (net.cell_mass / 8.0);
@@ -92,13 +96,14 @@ bool NewtonStepper::refactor(const SpringNetwork& net, const Eigen::Matrix3Xd& x
     ok = active().factorize();
   }
   if (!ok) return false;
-  m_x_factor.leftCols(net.node_count) = x.leftCols(net.node_count);
-  m_factor_dt = dt;
-  m_factor_tangent = tangent;
-  m_factor_mass_weight = wm;
-  m_factor_stiffness_weight = wk;
-  m_correction.clear();
-  m_uncorrected = false;
+  m_kept.x.leftCols(net.node_count) = x.leftCols(net.node_count);
+  m_kept.dt = dt;
+  m_kept.tangent = tangent;
+  m_kept.mass_weight = wm;
+  m_kept.stiffness_weight = wk;
+  m_kept.correction.clear();
+  m_kept.uncorrected = false;
+  m_taking_up = false; // a collected factor is older than this one
   return true;
 }
 
@@ -115,7 +120,7 @@ bool NewtonStepper::retopologise(const SpringNetwork& net, const Eigen::Matrix3X
   if (!active().bind_split_vertices(net)) return false;
   bind_free_entries(net);
   if (m_mode != Mode::implicit_euler) {
-    m_factor_dt = -1.0; // refactorised at the next advance
+    m_kept.dt = -1.0; // refactorised at the next advance
     return true;
   }
   // The kept factor is of the matrix before these splits: correct it for each (the copy has
@@ -124,24 +129,27 @@ bool NewtonStepper::retopologise(const SpringNetwork& net, const Eigen::Matrix3X
     int original = -1;
     for (int p = 0; p < first_copy && original < 0; ++p)
       if (net.rest.col(p) == net.rest.col(copy)) original = p;
-    if (original >= 0) m_x_factor.col(copy) = m_x_factor.col(original);
+    if (original >= 0) {
+      m_kept.x.col(copy) = m_kept.x.col(original);
+      if (m_taking_up) m_fresh.x.col(copy) = m_fresh.x.col(original);
+    }
     const long index = ++m_splits;
     RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)];
     r = RecordedSplit{index, original, copy,
                       original >= 0 ? net.mass[static_cast<std::size_t>(original)] + net.mass[static_cast<std::size_t>(copy)] : 0.0};
     // Full (or H singular): the kept factor stays uncorrected for this split until a refresh;
     // Newton then converges more slowly (and says so when it does not).
-    if (!correct_for_split(net, index)) m_uncorrected = true;
+    if (!correct_for_split(net, index, active(), m_kept)) m_kept.uncorrected = true;
   }
-  // A fresh factor of the torn network (if none is being computed: that one is corrected for
-  // this split when adopted).
-  if (m_factor_dt > 0.0) request_refresh(net, x, m_factor_dt);
+  // A fresh factor of the torn network (if none is being computed or taken up: that one is
+  // corrected for this split when taken up).
+  if (m_kept.dt > 0.0) request_refresh(net, x, m_kept.dt);
   return true;
 }
 
-bool NewtonStepper::correct_for_split(const SpringNetwork& net, long index) noexcept {
+bool NewtonStepper::correct_for_split(const SpringNetwork& net, long index, NetworkSystem& system, FactorState& factor) noexcept {
   const RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)];
-  if (r.index != index || r.original < 0 || m_factor_dt < 0.0) return false;
+  if (r.index != index || r.original < 0 || factor.dt < 0.0) return false;
   // The splits made after this one (when corrected for after them): their copies' corners are
   // taken back at their originals.
   SplitCorrection::NodePair later[SplitCorrection::max_splits];
@@ -155,12 +163,13 @@ bool NewtonStepper::correct_for_split(const SpringNetwork& net, long index) noex
   // kept matrix does not hold and leave a matrix of no one state (on clay_tear's pull, a
   // factor adopted with ten splits to correct then stepped 1.2-6 times too far, 10-75 degrees
   // off the torn network's own step, for the 16 samples until the next).
-  return m_correction.add(active(), net, m_x_factor, r.original, r.copy, r.mass_before, m_factor_mass_weight, m_factor_stiffness_weight,
-                          m_factor_tangent, later, later_count);
+  return factor.correction.add(system, net, factor.x, r.original, r.copy, r.mass_before, factor.mass_weight, factor.stiffness_weight,
+                               factor.tangent, later, later_count);
 }
 
 void NewtonStepper::request_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept {
-  if (!m_refresh || m_refresh->busy()) return;
+  // (The worker's system holds the collected factor while it is taken up.)
+  if (!m_refresh || m_refresh->busy() || m_taking_up) return;
   const double wm = mass_weight(dt), wk = stiffness_weight(net, dt);
   // With decoupled shadows the worker analyses the network as it is now (torn or not) first.
   const bool reanalyse = active().split_room() == NetworkSystem::SplitRoom::decoupled_shadows;
@@ -174,38 +183,55 @@ void NewtonStepper::request_refresh(const SpringNetwork& net, const Eigen::Matri
 }
 
 void NewtonStepper::collect_refresh(const SpringNetwork& net, NewtonReport& report) noexcept {
+  if (m_taking_up) {
+    if (m_take_up_call != m_calls) take_up(net, report); // (once per call: its budget is per call)
+    return;
+  }
   if (!m_refresh || !m_refresh->busy()) return;
   if (m_policy.delay >= 0) {
     if (m_calls < m_job_call + m_policy.delay) return;
-    m_refresh->wait(); // deterministic: this call adopts it, however long the worker took
+    m_refresh->wait(); // deterministic: this call collects it, however long the worker took
   } else if (!m_refresh->finished()) {
     return;
   }
   const FactorRefresh::Result result = m_refresh->collect();
   if (!result.factorised) return;
+  m_fresh.dt = m_job_dt;
+  m_fresh.tangent = result.tangent;
+  m_fresh.mass_weight = m_job_mass_weight;
+  m_fresh.stiffness_weight = m_job_stiffness_weight;
+  m_fresh.correction.clear();
+  m_fresh.uncorrected = false;
+  // The snapshot's positions, with the copies made since at their originals' places.
+  m_fresh.x.leftCols(net.node_count) = m_refresh->positions().leftCols(net.node_count);
+  for (long index = result.tag + 1; index <= m_splits; ++index)
+    if (const RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)]; r.index == index && r.original >= 0)
+      m_fresh.x.col(r.copy) = m_fresh.x.col(r.original);
+  m_fresh_next = result.tag + 1;
+  m_taking_up = true;
+  take_up(net, report);
+}
+
+void NewtonStepper::take_up(const SpringNetwork& net, NewtonReport& report) noexcept {
+  m_take_up_call = m_calls;
+  NetworkSystem& fresh = *m_systems[static_cast<std::size_t>(1 - m_active)];
+  // Splits made since its snapshot (or since the last call): bound, then corrected for, a few
+  // per call.
+  if (m_fresh_next <= m_splits && fresh.bound_nodes() < net.node_count && !fresh.bind_split_vertices(net)) m_fresh.uncorrected = true;
+  const long last = m_policy.corrections_per_call > 0 ? std::min(m_splits, m_fresh_next + m_policy.corrections_per_call - 1) : m_splits;
+  for (; m_fresh_next <= last; ++m_fresh_next, ++report.take_up_corrections)
+    if (!correct_for_split(net, m_fresh_next, fresh, m_fresh)) m_fresh.uncorrected = true;
+  if (m_fresh_next <= m_splits) return; // the kept factor (corrected for them all) serves meanwhile
+  m_taking_up = false;
   m_active = 1 - m_active;
-  m_factor_dt = m_job_dt;
-  m_factor_tangent = result.tangent;
-  m_factor_mass_weight = m_job_mass_weight;
-  m_factor_stiffness_weight = m_job_stiffness_weight;
-  m_correction.clear();
-  m_uncorrected = false;
+  std::swap(m_kept, m_fresh); // (the matrices and vectors swap their storage: allocation-free)
   ++report.refreshes;
-  // Splits made while it was computed: bound now, and corrected for.
-  if (result.tag < m_splits && !active().bind_split_vertices(net)) m_uncorrected = true;
   if (active().split_room() == NetworkSystem::SplitRoom::decoupled_shadows) {
     // Re-analysed: its own numbering of the dofs. The right-hand side's unused entries (the
     // decoupled shadows') must be zero.
     bind_free_entries(net);
     m_r.setZero();
   }
-  // The snapshot's positions, with the copies made since at their originals' places.
-  m_x_factor.leftCols(net.node_count) = m_refresh->positions().leftCols(net.node_count);
-  for (long index = result.tag + 1; index <= m_splits; ++index)
-    if (const RecordedSplit& r = m_recent[static_cast<std::size_t>(index % SplitCorrection::max_splits)]; r.index == index && r.original >= 0)
-      m_x_factor.col(r.copy) = m_x_factor.col(r.original);
-  for (long index = result.tag + 1; index <= m_splits; ++index)
-    if (!correct_for_split(net, index)) m_uncorrected = true;
 }
 
 void NewtonStepper::bind_free_entries(const SpringNetwork& net) noexcept {
@@ -300,7 +326,7 @@ NewtonReport NewtonStepper::advance_linearised_on_lattice(const SpringNetwork& n
   }
   // Never primed, a new dt, or a check found the kept factor stale: a fresh one at this
   // predictor, on this thread (the linearised step has no iteration to bridge a stale factor).
-  if (m_factor_dt != dt || m_refresh_pending) {
+  if (m_kept.dt != dt || m_refresh_pending) {
     if (!refactor(net, x, dt)) {
       report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
       return report;
@@ -353,7 +379,7 @@ NewtonReport NewtonStepper::advance_linearised(const SpringNetwork& net, Eigen::
     const int e = m_free_entry[static_cast<std::size_t>(k)];
     x.data()[e] += dt * v.data()[e];
   }
-  if (m_factor_dt != dt || m_refresh_pending) {
+  if (m_kept.dt != dt || m_refresh_pending) {
     if (!refactor(net, x, dt)) {
       report.residual = residual(net, x, v, dt);
       return report;
@@ -427,7 +453,7 @@ bool NewtonStepper::keep_factor_for(const SpringNetwork& net, const Eigen::Matri
   // with coupled shadows the torn network is factorised here, the one factorisation a servo step
   // may make; with decoupled ones (which cannot be assembled torn without a new analysis) the
   // iteration goes on with the factor as corrected so far while a fresh one is computed.
-  const bool refactor_here = m_factor_dt < 0.0 || (m_uncorrected && active().split_room() != NetworkSystem::SplitRoom::decoupled_shadows);
+  const bool refactor_here = m_kept.dt < 0.0 || (m_kept.uncorrected && active().split_room() != NetworkSystem::SplitRoom::decoupled_shadows);
   if (refactor_here) {
     // Never primed, or uncorrected splits on coupled shadows: factorise here.
     if (m_refresh) {
@@ -436,7 +462,7 @@ bool NewtonStepper::keep_factor_for(const SpringNetwork& net, const Eigen::Matri
     }
     if (!refactor(net, x, dt)) return false;
     ++report.factorisations;
-  } else if (m_factor_dt != dt || m_correction.splits() > 0 || m_uncorrected) {
+  } else if (m_kept.dt != dt || m_kept.correction.splits() > 0 || m_kept.uncorrected || m_taking_up) {
     // A new dt, or splits the kept factor is only corrected for: a fresh factor (if none is
     // being computed already).
     request_refresh(net, x, dt);
@@ -480,7 +506,7 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
   AndersonState anderson;
   while (report.iterations < m_max_iterations && norm > tolerance) {
     // The kept-factor step g = −Q⁻¹ r (Q: the kept factor corrected for the pending splits).
-    m_correction.solve(active(), m_r, m_dx);
+    m_kept.correction.solve(active(), m_r, m_dx);
     ++report.iterations;
     double slope = 0.0; // r · g: the potential's directional derivative along g (without damping)
     for (int k = 0; k < m; ++k) {
@@ -559,7 +585,7 @@ NewtonReport NewtonStepper::advance_static(const SpringNetwork& net, Eigen::Matr
   m_v0.leftCols(n) = v.leftCols(n);
   // `fresh`: the kept factorisation was computed at the current iterate.
   bool fresh = false;
-  if (m_factor_dt < 0.0) {
+  if (m_kept.dt < 0.0) {
     if (!refactor(net, x, dt)) {
       report.residual = residual(net, x, v, dt); // leaves forces() at the returned state
       return report;

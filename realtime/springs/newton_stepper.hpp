@@ -25,19 +25,26 @@ struct NewtonReport {
   int iterations = 0;
   int factorisations = 0; ///< numeric factorisations on the calling thread (the first, a quasi-static refresh, a rebuild)
   int refreshes = 0;      ///< fresh factors adopted from the worker at the start of this call
+  int take_up_corrections = 0; ///< splits a collected factor was corrected for in this call (FactorRefreshPolicy)
   bool converged = false;
   double residual = 0.0; ///< final max-norm of the residual [N]
 };
 
 /// How implicit Euler takes up a factor computed off the servo thread.
 struct FactorRefreshPolicy {
-  /// Calls between starting a refresh and adopting its factor; at that call the stepper waits
+  /// Calls between starting a refresh and collecting its factor; at that call the stepper waits
   /// for the worker if it has not finished, so that a run is the same whatever the machine's
   /// load (a study, a test). Negative: adopt at the first call after the worker has finished,
   /// never waiting (the live rig: not reproducible from run to run).
   int delay = 16;
   /// Anderson acceleration depth of the kept-factor iteration (0: plain modified Newton).
   int anderson_depth = 4;
+  /// A factor collected with splits made since its snapshot is corrected for at most this many
+  /// of them per call (the kept factor, already corrected for them, serving meanwhile) and taken
+  /// up at the call that corrects it for the last: the corrections of a burst of splits (each
+  /// ~9 forward substitutions) are spread over the calls instead of falling on one. 0: all at
+  /// the adopting call.
+  int corrections_per_call = 2;
 };
 
 class NewtonStepper {
@@ -114,7 +121,7 @@ public:
   /// caller need not recompute them. Linearly implicit: the forces at the predictor x*.
   [[nodiscard]] const Eigen::Matrix3Xd& forces() const { return m_f; }
   /// The tangent of the kept factor.
-  [[nodiscard]] CellTangent factor_tangent() const { return m_factor_tangent; }
+  [[nodiscard]] CellTangent factor_tangent() const { return m_kept.tangent; }
 
 private:
   NetworkSystem& active() { return *m_systems[static_cast<std::size_t>(m_active)]; }
@@ -126,12 +133,30 @@ private:
   [[nodiscard]] double stiffness_weight(const SpringNetwork& net, double dt) const;
   /// Starts a refresh at positions x (if none is running).
   void request_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
-  /// Adopts a finished refresh when the policy says so, corrected for the splits made since its
-  /// snapshot; counts it in `report`.
+  /// Collects a finished refresh when the policy says so and starts taking it up (take_up).
   void collect_refresh(const SpringNetwork& net, NewtonReport& report) noexcept;
-  /// Corrects the kept factor for split number `index` (recorded by `retopologise`), with the
-  /// moved cells' stiffness at the kept matrix's positions (m_x_factor).
-  bool correct_for_split(const SpringNetwork& net, long index) noexcept;
+  /// The collected factor (m_fresh) corrected for up to `corrections_per_call` more of the
+  /// splits made since its snapshot; once corrected for all, it becomes the kept factor (counted
+  /// in `report`).
+  void take_up(const SpringNetwork& net, NewtonReport& report) noexcept;
+  /// A factor and what its correction needs: its matrix's dt, tangent, weights and positions
+  /// (a copy made since at its original's place), its corrections, whether a split could not
+  /// be corrected for.
+  struct FactorState {
+    double dt = -1.0; ///< negative: none
+    CellTangent tangent = CellTangent::projected;
+    double mass_weight = 0.0, stiffness_weight = 0.0;
+    /// The positions the factor's matrix was assembled at; a copy made since sits at its
+    /// original's place (its cells were the original's there). A split's correction takes the
+    /// moved cells' stiffness at the matrix's own positions, so that the corrected matrix is
+    /// the torn network's at one state.
+    Eigen::Matrix3Xd x;
+    SplitCorrection correction;
+    bool uncorrected = false;
+  };
+  /// Corrects `factor` (of `system`) for split number `index` (recorded by `retopologise`), with
+  /// the moved cells' stiffness at the factor's matrix's positions.
+  bool correct_for_split(const SpringNetwork& net, long index, NetworkSystem& system, FactorState& factor) noexcept;
   double residual(const SpringNetwork& net, const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt,
                   LatticeForces::ForcePrecision precision = LatticeForces::ForcePrecision::double_precision) noexcept;
   NewtonReport advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
@@ -164,21 +189,21 @@ private:
   std::array<std::unique_ptr<NetworkSystem>, 2> m_systems; ///< the kept factor's and the refresh's
   int m_active = 0;
   std::unique_ptr<FactorRefresh> m_refresh; ///< the worker (implicit Euler)
-  SplitCorrection m_correction;
   LatticeForces m_forces;
   double m_tolerance_ratio;
   bool m_tear_ready = false;
-  // The kept factor: its dt (negative: none yet), tangent and weights.
-  double m_factor_dt = -1.0;
-  CellTangent m_factor_tangent = CellTangent::projected;
-  double m_factor_mass_weight = 0.0, m_factor_stiffness_weight = 0.0;
+  /// The kept factor (the active system's) and a collected one being taken up (the other
+  /// system's, while `m_taking_up`), corrected up to split `m_fresh_next` − 1.
+  FactorState m_kept, m_fresh;
+  bool m_taking_up = false;
+  long m_fresh_next = 0;
+  long m_take_up_call = -1; ///< the call that last went on taking it up
   // The running refresh: the call it started at, its dt and weights.
   long m_calls = 0;
   long m_job_call = 0;
   double m_job_dt = 0.0;
   double m_job_mass_weight = 0.0, m_job_stiffness_weight = 0.0;
   long m_splits = 0; ///< vertex splits bound so far
-  bool m_uncorrected = false; ///< a split the kept factor could not be corrected for: refactorise
   /// The last splits (by index modulo the ring's size): original, copy, the original's mass before.
   struct RecordedSplit {
     long index = -1;
@@ -191,11 +216,6 @@ private:
   int m_calls_since_check = 0;    ///< linearly implicit: calls since the residual after the step was last checked
   double m_potential = 0.0;       ///< the incremental potential at the last residual evaluation [J]
   Eigen::Matrix3Xd m_x0, m_v0, m_f, m_zero, m_x_before;
-  /// The positions the kept factor's matrix was assembled at; a copy made since sits at its
-  /// original's place (its cells were the original's there). A split's correction takes the
-  /// moved cells' stiffness at the kept matrix's own positions, so that the corrected matrix is
-  /// the torn network's at one state.
-  Eigen::Matrix3Xd m_x_factor;
   Eigen::VectorXd m_r, m_dx;
   // Anderson mixing, per free entry: the iterate, its step, the previous ones, their differences.
   Eigen::VectorXd m_u, m_g, m_u_previous, m_g_previous, m_u_next;

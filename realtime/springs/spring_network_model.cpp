@@ -402,6 +402,7 @@ void SpringNetworkModel::reset() {
   m_piece_label.assign(static_cast<std::size_t>(m_net.cell_count()), 0);
   m_pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
   m_refreshes = 0;
+  m_most_take_up_corrections = 0;
   m_unconverged = 0;
   m_newton.reset();
   if (m_setup.integrator == SpringIntegrator::implicit_euler)
@@ -490,6 +491,7 @@ bool SpringNetworkModel::advance_implicit(std::span<const ToolState> tools, doub
   m_last_substeps = report.iterations;
   m_factorisations += report.factorisations;
   m_refreshes += report.refreshes;
+  m_most_take_up_corrections = std::max(m_most_take_up_corrections, report.take_up_corrections);
   return !report.converged;
 }
 

@@ -147,6 +147,9 @@ public:
   [[nodiscard]] long factorisations() const { return m_factorisations; }
   /// Fresh factors the implicit integrator adopted from its worker since reset().
   [[nodiscard]] long refreshes() const { return m_refreshes; }
+  /// The most splits the implicit integrator corrected a collected factor for in one step since
+  /// reset() (FactorRefreshPolicy::corrections_per_call bounds it).
+  [[nodiscard]] int most_take_up_corrections() const { return m_most_take_up_corrections; }
   /// Samples since reset() that did not converge (or exceeded the explicit sub-step bound): the
   /// samples reported over budget.
   [[nodiscard]] long unconverged_samples() const { return m_unconverged; }
@@ -195,6 +198,7 @@ private:
   int m_tears = 0;
   long m_factorisations = 0;
   long m_refreshes = 0;
+  int m_most_take_up_corrections = 0;
   long m_unconverged = 0;
   int m_pieces = 1;
   LatticeForces m_lattice;               ///< the explicit integrator's force loops
