@@ -247,6 +247,7 @@ void tear_storm(benchmark::State& state, SpringIntegrator integrator) {
   state.counters["wall_max_us"] = 1e6 * wall.back();
   state.counters["unconverged"] = unconverged;
   state.counters["refreshes"] = static_cast<double>(model.refreshes());
+  state.counters["held"] = static_cast<double>(model.held_samples());
   state.counters["stepping_thread_factorisations"] = static_cast<double>(model.factorisations());
 }
 
@@ -303,6 +304,7 @@ void blade_press(benchmark::State& state) {
   state.counters["samples_over_1ms"] = static_cast<double>(std::count_if(cost.begin(), cost.end(), [](double c) { return c > 1e-3; }));
   state.counters["unconverged"] = unconverged;
   state.counters["refreshes"] = static_cast<double>(model.refreshes());
+  state.counters["held"] = static_cast<double>(model.held_samples());
   state.counters["stepping_thread_factorisations"] = static_cast<double>(model.factorisations());
 }
 

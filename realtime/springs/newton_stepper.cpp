@@ -504,6 +504,7 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
   }
   for (int k = 0; k < m; ++k) m_u[k] = x.data()[m_free_entry[static_cast<std::size_t>(k)]];
   AndersonState anderson;
+  bool stepped = false; // a step of this call was accepted
   while (report.iterations < m_max_iterations && norm > tolerance) {
     // The kept-factor step g = −Q⁻¹ r (Q: the kept factor corrected for the pending splits).
     m_kept.correction.solve(active(), m_r, m_dx);
@@ -543,6 +544,7 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
     if (accepted(trial, 1.0, mixed_slope)) {
       norm = trial;
       potential_is_double = true;
+      stepped = true;
       m_u.head(m) = m_u_next.head(m);
       continue;
     }
@@ -570,7 +572,21 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
     }
     norm = trial;
     potential_is_double = true;
+    stepped = true;
     m_u.head(m) = m_u_next.head(m);
+  }
+  if (!stepped && norm > tolerance) {
+    // Not one step accepted: the state is still the predictor xₙ + h vₙ, which carries the
+    // previous velocity on unopposed, and a run of such calls is free flight (on
+    // potato_rect_cut's withdrawal, a crushed 4³ network's nodes flew off at 1.3 m/s under a
+    // stale factor and the blade's force grew to 10²⁰ N). The call holds instead: x = xₙ and
+    // v = 0 on the free entries, the forces evaluated there, and it says it did not converge.
+    for (int k = 0; k < m; ++k) {
+      const int e = m_free_entry[static_cast<std::size_t>(k)];
+      x.data()[e] = m_x0.data()[e];
+    }
+    norm = residual(net, x, v, dt); // (v = (x − xₙ)/h = 0)
+    report.held = true;
   }
   report.residual = norm;
   report.converged = norm <= tolerance;

@@ -27,6 +27,9 @@ struct NewtonReport {
   int refreshes = 0;      ///< fresh factors adopted from the worker at the start of this call
   int take_up_corrections = 0; ///< splits a collected factor was corrected for in this call (FactorRefreshPolicy)
   bool converged = false;
+  /// Implicit Euler: no step was accepted, and the call held the state (x = xₙ, v = 0) instead
+  /// of returning the predictor xₙ + h vₙ (not converged).
+  bool held = false;
   double residual = 0.0; ///< final max-norm of the residual [N]
 };
 

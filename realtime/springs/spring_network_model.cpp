@@ -403,6 +403,7 @@ void SpringNetworkModel::reset() {
   m_pieces = network_pieces(m_net, m_piece_parent, m_piece_label);
   m_refreshes = 0;
   m_most_take_up_corrections = 0;
+  m_held = 0;
   m_unconverged = 0;
   m_newton.reset();
   if (m_setup.integrator == SpringIntegrator::implicit_euler)
@@ -492,6 +493,7 @@ bool SpringNetworkModel::advance_implicit(std::span<const ToolState> tools, doub
   m_factorisations += report.factorisations;
   m_refreshes += report.refreshes;
   m_most_take_up_corrections = std::max(m_most_take_up_corrections, report.take_up_corrections);
+  m_held += report.held ? 1 : 0;
   return !report.converged;
 }
 

@@ -150,6 +150,10 @@ public:
   /// The most splits the implicit integrator corrected a collected factor for in one step since
   /// reset() (FactorRefreshPolicy::corrections_per_call bounds it).
   [[nodiscard]] int most_take_up_corrections() const { return m_most_take_up_corrections; }
+  /// Samples since reset() in which the implicit integrator accepted no step and held the
+  /// network's free nodes where they were, at rest (NewtonReport::held); counted among the
+  /// unconverged samples too.
+  [[nodiscard]] long held_samples() const { return m_held; }
   /// Samples since reset() that did not converge (or exceeded the explicit sub-step bound): the
   /// samples reported over budget.
   [[nodiscard]] long unconverged_samples() const { return m_unconverged; }
@@ -199,6 +203,7 @@ private:
   long m_factorisations = 0;
   long m_refreshes = 0;
   int m_most_take_up_corrections = 0;
+  long m_held = 0;
   long m_unconverged = 0;
   int m_pieces = 1;
   LatticeForces m_lattice;               ///< the explicit integrator's force loops

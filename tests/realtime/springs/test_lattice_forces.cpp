@@ -34,7 +34,7 @@ struct Scattered {
   SpringNetwork net;
   Eigen::Matrix3Xd x, v;
 };
-Scattered scattered_block(unsigned seed) {
+Scattered scattered_block(unsigned seed, bool margin = false) {
   const double h = 2.5e-3;
   NetworkBlock block;
   block.origin = {0.01, -0.02, 0.003};
@@ -42,6 +42,11 @@ Scattered scattered_block(unsigned seed) {
   block.cells = {5, 3, 4};
   std::vector<bool> keep(60);
   for (std::size_t c = 0; c < keep.size(); ++c) keep[c] = c % 3 != 1;
+  // With a margin: the block's last x column and its top layer pruned, so that the kept cells'
+  // box (4 x 3 x 3 cells) is smaller than the block.
+  if (margin)
+    for (std::size_t c = 0; c < keep.size(); ++c)
+      if (c % 5 == 4 || c / 15 == 3) keep[c] = false;
   Scattered s{build_spring_network(block, keep, identify_cell_stiffness(0.5e6, 0.45, h, true).stiffness, 1700.0, 2e-5), {}, {}};
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -53,8 +58,8 @@ Scattered scattered_block(unsigned seed) {
 }
 
 TEST(LatticeForces, EqualTheCellSum) {
-  for (const unsigned seed : {1u, 2u, 3u}) {
-    Scattered s = scattered_block(seed);
+  for (const unsigned seed : {1u, 2u, 3u, 4u, 5u}) {
+    Scattered s = scattered_block(seed, seed > 3);
     LatticeForces lattice(s.net);
     ASSERT_TRUE(lattice.applies(s.net));
     Eigen::Matrix3Xd expected(3, s.net.node_capacity()), f(3, s.net.node_capacity());

@@ -141,3 +141,32 @@ TEST(SpringsOnScenes, ClayPullWithAGraspStiffnessGraspsCompliantly) {
   EXPECT_EQ(p["attached_nodes"][0].get<int>(), 0);
   EXPECT_NEAR(p["grasp_anchors"][0]["stiffness_sum_N_per_m"].get<double>(), k * M_PI * a * a / 2.0, 1e-8 * k * M_PI * a * a / 2.0);
 }
+
+TEST(SpringsOnScenes, ACrushedNetworkHoldsStillInsteadOfFlyingOffAsTheBladeWithdraws) {
+  // potato_rect_cut's blade pressed 10 mm into a 4³ network (h = 10 mm: the cells under the edge
+  // crushed flat), held and drawn back: on the way back some implicit steps accept no step of
+  // their kept-factor iteration (a factor far from the crushed tangent). Such a step holds the
+  // network (x = xₙ, v = 0) rather than returning the predictor xₙ + h vₙ, which would carry
+  // the last velocity on unopposed, sample after sample (the force on the blade then grew without
+  // bound, to 10²⁰ N). Expected: no force on the blade after the press beyond the press's own
+  // largest (the network only relaxes as the blade leaves), and failed steps that say so.
+  Scene scene = read_scene(fs::path(KERF_SOURCE_DIR) / "experiments" / "scenes" / "potato_rect_cut.toml");
+  if (!scene.springs) scene.springs = SpringsModelSettings{};
+  scene.springs->cells = 4;
+  const TetMesh mesh = scene_mesh(scene);
+  BuiltModel built = make_model("springs", scene, mesh, {});
+  const auto* springs = dynamic_cast<const SpringNetworkModel*>(&built.core_model());
+  ASSERT_NE(springs, nullptr);
+  std::vector<std::string> names;
+  for (const Tool& t : scene.tools) names.push_back(t.name);
+  const ForceProfile profile = run_model(*built.model, names, sample_scene_trajectories(scene));
+  // The deepest sample ends the press; the hold and the withdrawal follow.
+  std::size_t deepest = 0;
+  for (std::size_t i = 0; i < profile.rows.size(); ++i)
+    if (profile.rows[i].position.z() < profile.rows[deepest].position.z()) deepest = i;
+  double press = 0.0, after = 0.0;
+  for (std::size_t i = 0; i < profile.rows.size(); ++i) (i <= deepest ? press : after) = std::max(i <= deepest ? press : after, profile.rows[i].force.norm());
+  EXPECT_GT(press, 1.0);
+  EXPECT_LE(after, press) << "largest force after the press " << after << " N, during it " << press << " N";
+  EXPECT_GT(springs->unconverged_samples(), 0); // the withdrawal does fail steps (and says so)
+}
