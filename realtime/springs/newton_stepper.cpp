@@ -576,22 +576,25 @@ NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Ma
     m_u.head(m) = m_u_next.head(m);
   }
   if (!stepped && norm > tolerance) {
-    // Not one step accepted: the state is still the predictor xₙ + h vₙ, which carries the
-    // previous velocity on unopposed, and a run of such calls is free flight (on
-    // potato_rect_cut's withdrawal, a crushed 4³ network's nodes flew off at 1.3 m/s under a
-    // stale factor and the blade's force grew to 10²⁰ N). The call holds instead: x = xₙ and
-    // v = 0 on the free entries, the forces evaluated there, and it says it did not converge.
-    for (int k = 0; k < m; ++k) {
-      const int e = m_free_entry[static_cast<std::size_t>(k)];
-      x.data()[e] = m_x0.data()[e];
-    }
-    norm = residual(net, x, v, dt); // (v = (x − xₙ)/h = 0)
+    norm = hold(net, x, v, dt);
     report.held = true;
   }
   report.residual = norm;
   report.converged = norm <= tolerance;
   if (!report.converged || report.iterations > refresh_after_iterations) request_refresh(net, x, dt);
   return report;
+}
+
+double NewtonStepper::hold(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept {
+  // A call that accepted no step still holds the predictor xₙ + h vₙ, which carries the previous
+  // velocity on unopposed, and a run of such calls is free flight (on potato_rect_cut's
+  // withdrawal, a crushed 4³ network's nodes flew off at 1.3 m/s under a stale factor and the
+  // blade's force grew to 10²⁰ N). Held instead: x = xₙ and v = 0 on the free entries.
+  for (int k = 0; k < m_free_count; ++k) {
+    const int e = m_free_entry[static_cast<std::size_t>(k)];
+    x.data()[e] = m_x0.data()[e];
+  }
+  return residual(net, x, v, dt); // (v = (x − xₙ)/h = 0; the forces at the held state)
 }
 
 NewtonReport NewtonStepper::advance_static(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept {

@@ -165,6 +165,9 @@ private:
   NewtonReport advance_linearised_on_lattice(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
   NewtonReport advance_linearised(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
   NewtonReport advance_implicit(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
+  /// Implicit Euler's call that accepted no step: x = xₙ and v = 0 on the free entries (not the
+  /// predictor); returns the residual there, the forces evaluated at it.
+  double hold(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v, double dt) noexcept;
   /// Implicit Euler's factor for a step of dt at x: the kept one (corrected for pending splits),
   /// a fresh one asked for of the refresh worker when dt changed or splits are pending (adopted
   /// when ready), or — never primed, or splits the correction could not take on coupled
