@@ -594,7 +594,6 @@ void LatticeForces::find_exceptions(const SpringNetwork& net) noexcept {
       m_exceptions.push_back(c); // within the capacity reserved at construction
   }
   m_torn_topology = net.topology;
-  m_torn_found = true;
 }
 
 bool LatticeForces::applies(const SpringNetwork& net) const noexcept {
@@ -689,7 +688,7 @@ double LatticeForces::evaluate(const SpringNetwork& net, const Eigen::Matrix3Xd&
 
 double LatticeForces::evaluate_torn(const SpringNetwork& net, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& v,
                                     Eigen::Matrix3Xd& f) noexcept {
-  if (!m_torn_found || net.topology != m_torn_topology) find_exceptions(net);
+  if (net.topology != m_torn_topology) find_exceptions(net);
   // The lattice's own nodes (the first m_node_count: a split appends its copy) on the lattice,
   // with the constants and cells of the cells still there; a point whose node lost all its
   // cells to copies keeps its springs' zero constants.

@@ -144,8 +144,7 @@ private:
   /// lattice, the cells evaluated off it, and the topology these were found for.
   std::vector<double> m_k_torn, m_cell_torn;
   std::vector<int> m_exceptions;       ///< capacity: every cell (sized at construction)
-  std::uint64_t m_torn_topology = 0;
-  bool m_torn_found = false;
+  std::uint64_t m_torn_topology = 0; ///< 0: none found yet (a merge never gives 0)
   /// ForcePrecision::single_precision: u = x − X [m], v, f, one direction's forces, the cells'
   /// corner forces, the spring constants and the cell mask, in single precision.
   std::vector<float> m_u_single, m_v_single, m_f_single, m_g_single, m_q_single, m_k_single, m_cell_single;

@@ -183,10 +183,7 @@ void NewtonStepper::request_refresh(const SpringNetwork& net, const Eigen::Matri
 }
 
 void NewtonStepper::collect_refresh(const SpringNetwork& net, NewtonReport& report) noexcept {
-  if (m_taking_up) {
-    if (m_take_up_call != m_calls) take_up(net, report); // (once per call: its budget is per call)
-    return;
-  }
+  if (m_taking_up) return; // it goes on at the start of the call (advance_implicit)
   if (!m_refresh || !m_refresh->busy()) return;
   if (m_policy.delay >= 0) {
     if (m_calls < m_job_call + m_policy.delay) return;
@@ -213,7 +210,6 @@ void NewtonStepper::collect_refresh(const SpringNetwork& net, NewtonReport& repo
 }
 
 void NewtonStepper::take_up(const SpringNetwork& net, NewtonReport& report) noexcept {
-  m_take_up_call = m_calls;
   NetworkSystem& fresh = *m_systems[static_cast<std::size_t>(1 - m_active)];
   // Splits made since its snapshot (or since the last call): bound, then corrected for, a few
   // per call.
@@ -477,6 +473,7 @@ bool NewtonStepper::keep_factor_for(const SpringNetwork& net, const Eigen::Matri
 NewtonReport NewtonStepper::advance_implicit(const SpringNetwork& net, Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& v,
                                              double dt) noexcept {
   NewtonReport report;
+  if (m_taking_up) take_up(net, report); // (once per call: its corrections' budget is per call)
   collect_refresh(net, report);
   const int n = net.node_count;
   const int m = m_free_count;

@@ -136,7 +136,8 @@ private:
   [[nodiscard]] double stiffness_weight(const SpringNetwork& net, double dt) const;
   /// Starts a refresh at positions x (if none is running).
   void request_refresh(const SpringNetwork& net, const Eigen::Matrix3Xd& x, double dt) noexcept;
-  /// Collects a finished refresh when the policy says so and starts taking it up (take_up).
+  /// Collects a finished refresh when the policy says so and starts taking it up (take_up; a
+  /// take-up under way goes on at the start of the next call, not here).
   void collect_refresh(const SpringNetwork& net, NewtonReport& report) noexcept;
   /// The collected factor (m_fresh) corrected for up to `corrections_per_call` more of the
   /// splits made since its snapshot; once corrected for all, it becomes the kept factor (counted
@@ -203,7 +204,6 @@ private:
   FactorState m_kept, m_fresh;
   bool m_taking_up = false;
   long m_fresh_next = 0;
-  long m_take_up_call = -1; ///< the call that last went on taking it up
   // The running refresh: the call it started at, its dt and weights.
   long m_calls = 0;
   long m_job_call = 0;
